@@ -1,0 +1,37 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Timestamp association as done by the TUM RGB-D benchmark's associate.py.
+#pragma once
+
+#include <dynvo/common/export.h>
+
+#include <cstddef>
+#include <utility>
+#include <vector>
+
+namespace dynvo {
+
+/** \brief One-to-one association of two timestamp lists, as associate.py does.
+ *
+ * Every pair (a, b) with |a - (b + offset)| < max_difference is a candidate; candidates
+ * are taken greedily by increasing difference, each stamp being used at most once.
+ * \param[in] first timestamps (seconds), any order
+ * \param[in] second timestamps (seconds), any order
+ * \param[in] max_difference largest accepted difference (seconds), default 0.02
+ * \param[in] offset added to the second list's stamps (seconds), default 0
+ * \return index pairs (into first, into second), sorted by the first stamp
+ */
+DYNVO_EXPORTS std::vector<std::pair<std::size_t, std::size_t>>
+associateTimestamps(const std::vector<double>& first,
+                    const std::vector<double>& second,
+                    double max_difference = 0.02,
+                    double offset = 0.0);
+
+/** \brief Index of the element of the sorted list closest to t, found exactly as
+ * the TUM benchmark's find_closest_index (binary search keeping the best probe).
+ * \param[in] sorted non-empty list sorted in increasing order
+ * \param[in] t query value
+ */
+DYNVO_EXPORTS std::size_t
+findClosestIndex(const std::vector<double>& sorted, double t);
+
+} // namespace dynvo

@@ -1,0 +1,44 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// TUM trajectory files: "timestamp tx ty tz qx qy qz qw", camera-to-world.
+#pragma once
+
+#include <dynvo/common/export.h>
+
+#include <Eigen/Geometry>
+
+#include <string>
+#include <vector>
+
+namespace dynvo {
+
+/// A camera pose at a time: T_world_camera maps camera coordinates to world (metres).
+struct StampedPose {
+  double timestamp = 0.0;                                     ///< seconds
+  Eigen::Isometry3d T_world_camera = Eigen::Isometry3d::Identity(); ///< camera-to-world
+};
+
+using Trajectory = std::vector<StampedPose>;
+
+/** \brief Read a TUM trajectory file.
+ *
+ * '#' comment lines and blank lines are skipped. Every other line must hold exactly 8
+ * finite numbers, timestamps must increase strictly, and the quaternion norm must be
+ * within 1e-3 of 1 (it is then normalised).
+ * \throws pcl::IOException "<file>:<line>: <problem>" on any violation or when the file
+ *         cannot be opened
+ */
+DYNVO_EXPORTS Trajectory
+readTrajectory(const std::string& path);
+
+/** \brief Write a TUM trajectory file (timestamps "%.6f", qw >= 0).
+ * The file is written beside its destination and renamed into place, so a failure never
+ * leaves a truncated file. \throws pcl::IOException when it cannot be written
+ */
+DYNVO_EXPORTS void
+writeTrajectory(const std::string& path, const Trajectory& trajectory);
+
+/// One TUM line for a pose, without the newline.
+DYNVO_EXPORTS std::string
+formatTumLine(const StampedPose& pose);
+
+} // namespace dynvo

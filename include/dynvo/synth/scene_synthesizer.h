@@ -1,0 +1,150 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Deterministic synthetic RGB-D sequences of textured rooms with rigid moving objects.
+#pragma once
+
+#include <dynvo/common/camera.h>
+#include <dynvo/common/export.h>
+#include <dynvo/io/frame.h>
+
+#include <Eigen/Geometry>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace dynvo {
+
+/// A named scripted scenario.
+struct ScenarioInfo {
+  std::string name;        ///< e.g. "moving_crossing"
+  std::string description; ///< one line
+};
+
+/// Pose and state of one scripted object at one frame.
+struct ObjectState {
+  int id = 0;                                                   ///< 1, 2, ... (label value)
+  Eigen::Isometry3d T_world_object = Eigen::Isometry3d::Identity(); ///< object-to-world (metres)
+  bool moving = false; ///< true when the object moves between the previous frame and this one
+  /// Half sizes of the box along the object's x, y, z axes (metres); the box is centred
+  /// on the object frame's origin.
+  Eigen::Vector3d half_extents = Eigen::Vector3d::Zero();
+};
+
+/// One rendered frame with its ground truth.
+struct SynthFrame {
+  double timestamp = 0.0;       ///< seconds (colour stamp)
+  double depth_timestamp = 0.0; ///< seconds (depth stamp, a few ms after the colour one)
+  ColorImage color;             ///< shaded, textured colour image
+  DepthImage depth;             ///< metres after the depth model; NaN = no measurement
+  std::vector<std::uint8_t> labels; ///< per pixel: 0 static, k for object k while it moves
+  Eigen::Isometry3d T_world_camera = Eigen::Isometry3d::Identity(); ///< camera-to-world
+  std::vector<ObjectState> objects; ///< every object of the scenario
+};
+
+/// Options of a synthetic sequence.
+struct SynthOptions {
+  std::string scenario = "moving_crossing"; ///< one of SceneSynthesizer::scenarios()
+  int frames = 300;                         ///< number of frames (> 0)
+  std::uint32_t seed = 0;                   ///< seeds textures' jitter and the depth noise
+  int width = 640;                          ///< image columns (px)
+  int height = 480;                         ///< image rows (px)
+  double fps = 30.0;                        ///< frame rate (Hz)
+  bool noise = true; ///< Kinect-like depth model on; off = exact depth, no holes or dropouts
+  /// Intrinsics at 640x480 (scaled with width/height); the "default" preset.
+  CameraIntrinsics intrinsics;
+
+  /// \throws std::invalid_argument on an unknown scenario or an out-of-range value
+  void
+  validate() const;
+};
+
+/** \brief Renders scripted dynamic scenes by ray casting (deterministic for a seed).
+ *
+ * World frame: x right, y down (floor at y = +1.4), z forward, metres. The room spans
+ * [-2.5, 2.5] x [-1.6, 1.4] x [-1.0, 4.2] and holds two static furniture boxes; the
+ * scripted objects are oriented boxes. Every pixel casts one ray through its centre; the
+ * depth is the hit point's z in the camera frame (TUM convention, not the range).
+ *
+ * Appearance: every face carries its own procedural texture (seeded): two layers of
+ * smoothly interpolated colour value noise (0.35 m and 0.09 m lattices) times four
+ * octaves of luminance value noise (48, 24, 12 and 6 mm lattices). Octaves whose lattice
+ * would span fewer than 3 px fade out (gone below 1.5 px) using the pixel footprint at
+ * the hit point, so the image is band-limited and sub-pixel tracking stays accurate.
+ * Shading is Lambertian under one fixed directional light plus ambient light, so a
+ * surface looks the same from every viewpoint (no shadows, no specular highlights).
+ *
+ * Motion: the camera follows sums of sinusoids (about 0.1-0.3 m/s and up to about
+ * 4 deg/s) in the moving-camera scenarios and is fixed (constant, non-identity pose
+ * looking 11.5 deg down) in the static ones. Objects follow smooth 6-DoF scripts at about
+ * 1-5 cm per frame at 30 Hz; stop_and_go objects rest for stretches and then move with
+ * 0.25 s raised-cosine speed ramps. Object k is "moving" at frame k exactly when its pose
+ * differs from the one at the previous frame, and only then labels its pixels with k.
+ *
+ * Depth model (SynthOptions::noise): Gaussian noise with sigma = NOISE_SIGMA_PER_Z2 z^2,
+ * Kinect disparity quantisation (inverse depth in steps of INVERSE_DEPTH_STEP), holes on
+ * the far side of depth jumps larger than EDGE_JUMP_RATIO of the depth, DROPOUT_RATE
+ * random dropouts, and no measurement outside [MIN_DEPTH, MAX_DEPTH]. The random numbers
+ * are a hash of (seed, frame, pixel), so render(k) does not depend on call order or
+ * threads. Without noise the depth is the exact ray depth everywhere.
+ *
+ * Timestamps: colour stamp FIRST_STAMP + k / fps, depth stamp DEPTH_STAMP_DELAY later;
+ * the depth image shows the scene at the colour stamp (a synchronised, registered sensor).
+ *
+ * \code
+ * dynvo::SynthOptions options;
+ * options.scenario = "static_two";
+ * dynvo::SceneSynthesizer synth(options);
+ * dynvo::SynthFrame f0 = synth.render(0), f1 = synth.render(1);
+ * \endcode
+ */
+class DYNVO_EXPORTS SceneSynthesizer {
+public:
+  static constexpr double MIN_DEPTH = 0.5;             ///< nearest measurable depth (m)
+  static constexpr double MAX_DEPTH = 4.5;             ///< farthest measurable depth (m)
+  static constexpr double NOISE_SIGMA_PER_Z2 = 1.2e-3; ///< noise sigma / z^2 (1/m)
+  /// Kinect inverse-depth step (1/m): 1/8 px disparity / (0.075 m baseline * 580 px).
+  static constexpr double INVERSE_DEPTH_STEP = 0.125 / (0.075 * 580.0);
+  static constexpr double DROPOUT_RATE = 0.01;   ///< fraction of pixels randomly lost
+  static constexpr double EDGE_JUMP_RATIO = 0.05; ///< depth jump (fraction of z) making a hole
+  static constexpr double FIRST_STAMP = 1.0;       ///< colour stamp of frame 0 (s)
+  static constexpr double DEPTH_STAMP_DELAY = 0.005; ///< depth stamp - colour stamp (s)
+  static constexpr double DEPTH_PNG_SCALE = 5000.0;  ///< depth PNG units per metre
+
+  /// \throws std::invalid_argument when options.validate() fails
+  explicit SceneSynthesizer(const SynthOptions& options);
+  ~SceneSynthesizer();
+
+  /// Every scenario, in a fixed order.
+  static std::vector<ScenarioInfo>
+  scenarios();
+
+  /// Intrinsics actually used (scaled to the image size).
+  CameraIntrinsics
+  intrinsics() const;
+
+  /// Render frame k (0 <= k < frames). Independent of call order; thread-safe.
+  /// \throws std::invalid_argument when k is out of range
+  SynthFrame
+  render(int k) const;
+
+  /** \brief Write the whole sequence in the TUM layout: rgb/, depth/ (16-bit, 5000 per
+   * metre), labels/ (uint8), rgb.txt, depth.txt, groundtruth.txt, objects.txt.
+   *
+   * Files are named by their stamp ("%.6f.png"); labels use the colour stamp.
+   * groundtruth.txt holds T_world_camera at the colour stamps; objects.txt one line per
+   * frame and object: "timestamp id tx ty tz qx qy qz qw moving" (object-to-world).
+   * \param[in] folder must not exist or be empty; nothing existing is overwritten
+   * \param[in] threads worker threads (>= 1); the bytes written do not depend on it
+   * \throws pcl::IOException when the folder is not empty or cannot be written
+   * \throws std::invalid_argument when threads < 1
+   */
+  void
+  writeSequence(const std::string& folder, int threads) const;
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+} // namespace dynvo

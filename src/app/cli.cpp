@@ -1,0 +1,139 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <dynvo/app/cli.h>
+
+#include <pcl/console/print.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+namespace dynvo::app {
+
+Arguments::Arguments(int argc,
+                     const char* const* argv,
+                     std::vector<Option> options,
+                     std::size_t positional)
+: options_(std::move(options))
+{
+  for (int k = 1; k < argc; ++k) {
+    const std::string token = argv[k];
+    if (token == "-h" || token == "--help") {
+      help_ = true;
+      continue;
+    }
+    const bool is_flag = token.size() > 1 && token[0] == '-' &&
+                         !(std::isdigit(static_cast<unsigned char>(token[1])) ||
+                           token[1] == '.');
+    if (!is_flag) {
+      positional_.push_back(token);
+      continue;
+    }
+    const std::string name = token.substr(1);
+    const auto option = std::find_if(options_.begin(), options_.end(),
+                                     [&](const Option& o) { return o.name == name; });
+    if (option == options_.end())
+      throw UsageError("unknown option '" + token + "'");
+    if (has(name))
+      throw UsageError("option '" + token + "' given twice");
+    std::string value;
+    if (!option->value_name.empty()) {
+      if (k + 1 >= argc)
+        throw UsageError("option '" + token + "' needs a value (" + option->value_name +
+                         ")");
+      value = argv[++k];
+    }
+    given_.emplace_back(name, value);
+  }
+  if (!help_ && positional_.size() != positional)
+    throw UsageError("expected " + std::to_string(positional) +
+                     " positional argument(s), got " +
+                     std::to_string(positional_.size()));
+}
+
+bool
+Arguments::has(const std::string& name) const
+{
+  return std::any_of(given_.begin(), given_.end(),
+                     [&](const auto& g) { return g.first == name; });
+}
+
+std::string
+Arguments::string(const std::string& name, const std::string& fallback) const
+{
+  for (const auto& [given_name, value] : given_)
+    if (given_name == name)
+      return value;
+  return fallback;
+}
+
+double
+Arguments::number(const std::string& name, double fallback) const
+{
+  if (!has(name))
+    return fallback;
+  const std::string text = string(name);
+  std::size_t used = 0;
+  double value = NAN;
+  try {
+    value = std::stod(text, &used);
+  }
+  catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size() || !std::isfinite(value))
+    throw UsageError("option '-" + name + "' expects a number, got '" + text + "'");
+  return value;
+}
+
+long
+Arguments::integer(const std::string& name, long fallback) const
+{
+  if (!has(name))
+    return fallback;
+  const std::string text = string(name);
+  std::size_t used = 0;
+  long value = 0;
+  try {
+    value = std::stol(text, &used);
+  }
+  catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size())
+    throw UsageError("option '-" + name + "' expects an integer, got '" + text + "'");
+  return value;
+}
+
+std::string
+Arguments::optionsHelp() const
+{
+  std::ostringstream out;
+  for (const Option& option : options_) {
+    std::string head = "  -" + option.name;
+    if (!option.value_name.empty())
+      head += " " + option.value_name;
+    out << head << std::string(head.size() < 24 ? 24 - head.size() : 1, ' ')
+        << option.help << "\n";
+  }
+  return out.str();
+}
+
+int
+runApp(const std::string& usage, const std::function<int()>& body)
+{
+  try {
+    return body();
+  }
+  catch (const UsageError& e) {
+    std::fprintf(stderr, "Error: %s\nUsage: %s\n(-h lists the options)\n", e.what(),
+                 usage.c_str());
+    return 2;
+  }
+  catch (const std::exception& e) {
+    pcl::console::print_error("Error: %s\n", e.what());
+    return 1;
+  }
+}
+
+} // namespace dynvo::app

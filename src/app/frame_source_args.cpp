@@ -1,0 +1,74 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <dynvo/app/frame_source_args.h>
+#include <dynvo/io/oni_file_source.h>
+#include <dynvo/io/pcd_sequence_source.h>
+#include <dynvo/io/tum_folder_source.h>
+
+namespace dynvo::app {
+
+std::vector<Option>
+frameSourceOptions()
+{
+  std::string presets;
+  for (const auto& name : CameraIntrinsics::presetNames())
+    presets += (presets.empty() ? "" : "|") + name;
+  return {
+      {"tum_dir", "DIR", "TUM RGB-D folder (rgb.txt + depth.txt, or associations.txt)"},
+      {"pcd_dir", "DIR", "folder of organized .pcd files, natural name order"},
+      {"oni", "FILE", "OpenNI .oni recording"},
+      {"camera", presets, "intrinsics preset (default: default = 525 525 319.5 239.5)"},
+      {"fx", "PX", "focal length x, overrides the preset"},
+      {"fy", "PX", "focal length y, overrides the preset"},
+      {"cx", "PX", "principal point x, overrides the preset"},
+      {"cy", "PX", "principal point y, overrides the preset"},
+      {"depth_scale", "S", "raw depth units per metre (default: 5000 TUM, 1000 associations.txt)"},
+      {"fps", "HZ", "frame rate for PCD files whose names are not timestamps (default 30)"},
+  };
+}
+
+CameraIntrinsics
+intrinsicsFromArguments(const Arguments& args)
+{
+  CameraIntrinsics intrinsics;
+  try {
+    intrinsics = CameraIntrinsics::fromPreset(args.string("camera", "default"));
+  }
+  catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  intrinsics.fx = args.number("fx", intrinsics.fx);
+  intrinsics.fy = args.number("fy", intrinsics.fy);
+  intrinsics.cx = args.number("cx", intrinsics.cx);
+  intrinsics.cy = args.number("cy", intrinsics.cy);
+  try {
+    intrinsics.validate();
+  }
+  catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  return intrinsics;
+}
+
+FrameSource::Ptr
+openFrameSource(const Arguments& args)
+{
+  const int given = args.has("tum_dir") + args.has("pcd_dir") + args.has("oni");
+  if (given != 1)
+    throw UsageError("give exactly one of -tum_dir, -pcd_dir, -oni");
+  if (args.has("pcd_dir")) {
+    const double fps = args.number("fps", 30.0);
+    if (!(fps > 0.0))
+      throw UsageError("-fps must be positive");
+    return std::make_unique<PcdSequenceSource>(args.string("pcd_dir"), fps);
+  }
+  if (args.has("oni"))
+    return std::make_unique<OniFileSource>(args.string("oni"));
+  TumFolderSource::Options options;
+  options.intrinsics = intrinsicsFromArguments(args);
+  options.depth_scale = args.number("depth_scale", 0.0);
+  if (args.has("depth_scale") && !(options.depth_scale > 0.0))
+    throw UsageError("-depth_scale must be positive");
+  return std::make_unique<TumFolderSource>(args.string("tum_dir"), options);
+}
+
+} // namespace dynvo::app

@@ -1,0 +1,213 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <dynvo/common/timestamps.h>
+#include <dynvo/io/tum_folder_source.h>
+
+#include <pcl/exceptions.h>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+namespace dynvo {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+[[noreturn]] void
+fail(const std::string& message)
+{
+  throw pcl::IOException(message);
+}
+
+/// Non-comment, non-blank lines of a text file with their 1-based line numbers.
+std::vector<std::pair<int, std::string>>
+readIndexLines(const fs::path& path)
+{
+  std::ifstream in(path);
+  if (!in)
+    fail(path.string() + ": cannot open file");
+  std::vector<std::pair<int, std::string>> lines;
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#')
+      continue;
+    lines.emplace_back(number, line);
+  }
+  return lines;
+}
+
+struct StampedFile {
+  double stamp;
+  std::string file;
+};
+
+double
+parseStamp(const std::string& token, const fs::path& path, int line)
+{
+  std::size_t used = 0;
+  double stamp = std::numeric_limits<double>::quiet_NaN();
+  try {
+    stamp = std::stod(token, &used);
+  }
+  catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != token.size() || !std::isfinite(stamp))
+    fail(path.string() + ":" + std::to_string(line) + ": bad timestamp '" + token + "'");
+  return stamp;
+}
+
+std::vector<StampedFile>
+readFileList(const fs::path& path)
+{
+  std::vector<StampedFile> list;
+  for (const auto& [number, line] : readIndexLines(path)) {
+    std::istringstream tokens(line);
+    std::string stamp, file;
+    if (!(tokens >> stamp >> file))
+      fail(path.string() + ":" + std::to_string(number) +
+           ": expected 'timestamp filename'");
+    list.push_back({parseStamp(stamp, path, number), file});
+  }
+  if (list.empty())
+    fail(path.string() + ": no entries");
+  return list;
+}
+
+ColorImage
+readColor(const fs::path& path)
+{
+  cv::Mat image = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
+  if (image.empty())
+    fail(path.string() + ": cannot read colour image (missing or corrupt)");
+  if (image.depth() != CV_8U || (image.channels() != 3 && image.channels() != 4))
+    fail(path.string() + ": colour image must be 8-bit with 3 or 4 channels, got " +
+         std::to_string(8 * image.elemSize1()) + "-bit with " +
+         std::to_string(image.channels()) + " channel(s)");
+  ColorImage color;
+  color.width = image.cols;
+  color.height = image.rows;
+  color.data.resize(3 * image.total());
+  const int channels = image.channels();
+  for (int v = 0; v < image.rows; ++v) {
+    const std::uint8_t* row = image.ptr<std::uint8_t>(v);
+    std::uint8_t* out = color.data.data() + 3 * static_cast<std::size_t>(v) * image.cols;
+    for (int u = 0; u < image.cols; ++u) {
+      // OpenCV stores BGR(A).
+      out[3 * u] = row[channels * u + 2];
+      out[3 * u + 1] = row[channels * u + 1];
+      out[3 * u + 2] = row[channels * u];
+    }
+  }
+  return color;
+}
+
+DepthImage
+readDepth(const fs::path& path, double depth_scale)
+{
+  cv::Mat image = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
+  if (image.empty())
+    fail(path.string() + ": cannot read depth image (missing or corrupt)");
+  if (image.type() != CV_16UC1)
+    fail(path.string() + ": depth image must be 16-bit single channel, got " +
+         std::to_string(8 * image.elemSize1()) + "-bit with " +
+         std::to_string(image.channels()) + " channel(s)");
+  DepthImage depth;
+  depth.width = image.cols;
+  depth.height = image.rows;
+  depth.data.resize(image.total());
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inv_scale = static_cast<float>(1.0 / depth_scale);
+  for (int v = 0; v < image.rows; ++v) {
+    const std::uint16_t* row = image.ptr<std::uint16_t>(v);
+    float* out = depth.data.data() + static_cast<std::size_t>(v) * image.cols;
+    for (int u = 0; u < image.cols; ++u)
+      out[u] = row[u] == 0 ? nan : static_cast<float>(row[u]) * inv_scale;
+  }
+  return depth;
+}
+
+} // namespace
+
+TumFolderSource::TumFolderSource(const std::string& folder, const Options& options)
+: folder_(folder), options_(options)
+{
+  options_.intrinsics.validate();
+  if (!(options_.depth_scale >= 0.0) || !std::isfinite(options_.depth_scale))
+    throw std::invalid_argument("[dynvo::TumFolderSource] depth scale must be positive");
+  const fs::path dir(folder);
+  if (!fs::is_directory(dir))
+    fail(folder + ": not a directory");
+
+  const fs::path associations = dir / "associations.txt";
+  if (fs::exists(associations) && !fs::exists(dir / "rgb.txt")) {
+    depth_scale_ = options_.depth_scale > 0.0 ? options_.depth_scale : 1000.0;
+    for (const auto& [number, line] : readIndexLines(associations)) {
+      std::istringstream tokens(line);
+      std::string t_rgb, rgb, t_depth, depth;
+      if (!(tokens >> t_rgb >> rgb >> t_depth >> depth))
+        fail(associations.string() + ":" + std::to_string(number) +
+             ": expected 't_rgb rgb_file t_depth depth_file'");
+      entries_.push_back({parseStamp(t_rgb, associations, number),
+                          rgb,
+                          parseStamp(t_depth, associations, number),
+                          depth});
+    }
+  }
+  else {
+    depth_scale_ = options_.depth_scale > 0.0 ? options_.depth_scale : 5000.0;
+    const auto rgb = readFileList(dir / "rgb.txt");
+    const auto depth = readFileList(dir / "depth.txt");
+    std::vector<double> rgb_stamps, depth_stamps;
+    for (const auto& entry : rgb)
+      rgb_stamps.push_back(entry.stamp);
+    for (const auto& entry : depth)
+      depth_stamps.push_back(entry.stamp);
+    for (const auto& [i, j] :
+         associateTimestamps(rgb_stamps, depth_stamps, options_.max_difference))
+      entries_.push_back({rgb[i].stamp, rgb[i].file, depth[j].stamp, depth[j].file});
+  }
+  if (entries_.empty())
+    fail(folder + ": no colour image has a depth image within " +
+         std::to_string(options_.max_difference) + " s");
+  for (std::size_t i = 1; i < entries_.size(); ++i)
+    if (!(entries_[i].rgb_stamp > entries_[i - 1].rgb_stamp))
+      fail(folder + ": timestamps do not increase at entry " + std::to_string(i + 1) +
+           " (" + entries_[i].rgb_file + ")");
+}
+
+Frame
+TumFolderSource::read(std::size_t i) const
+{
+  const Entry& entry = entries_.at(i);
+  const fs::path dir(folder_);
+  Frame frame;
+  frame.timestamp = entry.rgb_stamp;
+  frame.name = (dir / entry.rgb_file).string();
+  frame.color = readColor(dir / entry.rgb_file);
+  frame.depth = readDepth(dir / entry.depth_file, depth_scale_);
+  if (frame.color.width != frame.depth.width || frame.color.height != frame.depth.height)
+    fail((dir / entry.depth_file).string() + ": depth image size differs from " +
+         entry.rgb_file);
+  frame.cloud = makeOrganizedCloud(frame.color, frame.depth, options_.intrinsics);
+  return frame;
+}
+
+bool
+TumFolderSource::next(Frame& frame)
+{
+  if (cursor_ >= entries_.size())
+    return false;
+  frame = read(cursor_);
+  ++cursor_;
+  return true;
+}
+
+} // namespace dynvo
