@@ -2,6 +2,7 @@
 #include <dynvo/app/cli.h>
 
 #include <pcl/console/print.h>
+#include <pcl/exceptions.h>
 
 #include <algorithm>
 #include <cmath>
@@ -129,6 +130,10 @@ runApp(const std::string& usage, const std::function<int()>& body)
     std::fprintf(stderr, "Error: %s\nUsage: %s\n(-h lists the options)\n", e.what(),
                  usage.c_str());
     return 2;
+  }
+  catch (const pcl::PCLException& e) {
+    pcl::console::print_error("Error: %s\n", e.getMessage().c_str());
+    return 1;
   }
   catch (const std::exception& e) {
     pcl::console::print_error("Error: %s\n", e.what());

@@ -18,8 +18,9 @@ TempDir::TempDir()
   for (char& c : name)
     if (c == '/')
       c = '_';
+  static int counter = 0;
   path_ = std::filesystem::temp_directory_path() /
-          (name + "_" + std::to_string(::getpid()));
+          (name + "_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
   std::filesystem::remove_all(path_);
   std::filesystem::create_directories(path_);
 }
