@@ -43,13 +43,7 @@ main(int argc, char** argv)
     const auto estimate = dynvo::readTrajectory(args.positional()[1]);
     const dynvo::RpeResult rpe = dynvo::computeRpe(groundtruth, estimate, options);
     const dynvo::AteResult ate = dynvo::computeAte(groundtruth, estimate);
-    const char* format =
-        args.has("json")
-            ? "{\"rpe_trans_rmse\": %.6f, \"rpe_trans_mean\": %.6f, \"rpe_rot_rmse\": "
-              "%.6f, \"ate_rmse\": %.6f, \"pairs\": %zu}\n"
-            : "rpe_trans_rmse=%.6f rpe_trans_mean=%.6f rpe_rot_rmse=%.6f ate_rmse=%.6f "
-              "pairs=%zu\n";
-    std::printf(format, rpe.trans_rmse, rpe.trans_mean, rpe.rot_rmse, ate.rmse, rpe.pairs);
+    std::printf("%s\n", dynvo::formatMetrics(rpe, ate, args.has("json")).c_str());
     return 0;
   });
 }

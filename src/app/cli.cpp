@@ -120,6 +120,17 @@ Arguments::optionsHelp() const
   return out.str();
 }
 
+std::string
+errorMessage(const std::exception& e)
+{
+  // PCLException::what() is "<function> in <file> @ <line> : <message>"; the message alone
+  // is what users need, and dynvo's messages already name the file they are about.
+  const std::string what = e.what();
+  if (dynamic_cast<const pcl::PCLException*>(&e) && what.rfind(": ", 0) == 0)
+    return what.substr(2);
+  return what;
+}
+
 int
 runApp(const std::string& usage, const std::function<int()>& body)
 {
@@ -131,12 +142,8 @@ runApp(const std::string& usage, const std::function<int()>& body)
                  usage.c_str());
     return 2;
   }
-  catch (const pcl::PCLException& e) {
-    pcl::console::print_error("Error: %s\n", e.getMessage().c_str());
-    return 1;
-  }
   catch (const std::exception& e) {
-    pcl::console::print_error("Error: %s\n", e.what());
+    pcl::console::print_error("Error: %s\n", errorMessage(e).c_str());
     return 1;
   }
 }

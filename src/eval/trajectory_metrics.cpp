@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 namespace dynvo {
@@ -115,6 +116,20 @@ computeAte(const Trajectory& groundtruth, const Trajectory& estimate, double max
   result.rmse = std::sqrt(residual.colwise().squaredNorm().mean());
   result.pairs = matches.size();
   return result;
+}
+
+std::string
+formatMetrics(const RpeResult& rpe, const AteResult& ate, bool json)
+{
+  const char* format =
+      json ? "{\"rpe_trans_rmse\": %.6f, \"rpe_trans_mean\": %.6f, \"rpe_rot_rmse\": %.6f, "
+             "\"ate_rmse\": %.6f, \"pairs\": %zu}"
+           : "rpe_trans_rmse=%.6f rpe_trans_mean=%.6f rpe_rot_rmse=%.6f ate_rmse=%.6f "
+             "pairs=%zu";
+  char line[256];
+  std::snprintf(line, sizeof(line), format, rpe.trans_rmse, rpe.trans_mean, rpe.rot_rmse,
+                ate.rmse, rpe.pairs);
+  return line;
 }
 
 } // namespace dynvo

@@ -83,6 +83,10 @@ private:
   bool help_ = false;
 };
 
+/// The message of an exception without PCLException's ": " prefix.
+DYNVO_EXPORTS std::string
+errorMessage(const std::exception& e);
+
 /** \brief Runs an app's body with the house exit-code policy.
  * UsageError: message and usage on stderr, exit 2. Other std::exception: message via
  * pcl::console::print_error, exit 1. Otherwise the body's return value (0 or 1).

@@ -6,6 +6,7 @@
 #include <dynvo/io/trajectory_io.h>
 
 #include <cstddef>
+#include <string>
 
 namespace dynvo {
 
@@ -61,5 +62,12 @@ DYNVO_EXPORTS AteResult
 computeAte(const Trajectory& groundtruth,
            const Trajectory& estimate,
            double max_difference = 0.02);
+
+/** \brief The result line of dynvo_evaluate:
+ * "rpe_trans_rmse=<m/s> rpe_trans_mean=<m/s> rpe_rot_rmse=<deg/s> ate_rmse=<m> pairs=<n>",
+ * or the same fields as one JSON object; no trailing newline.
+ */
+DYNVO_EXPORTS std::string
+formatMetrics(const RpeResult& rpe, const AteResult& ate, bool json = false);
 
 } // namespace dynvo

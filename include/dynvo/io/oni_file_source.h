@@ -13,10 +13,31 @@ namespace dynvo {
 /** \brief Plays an .oni recording with pcl::io::OpenNI2Grabber, delivering every
  * recorded frame in order, none dropped (playback is stepped frame by frame).
  *
- * Clouds are organized PointXYZRGB in metres (the grabber's own registration and
- * intrinsics); the timestamp is the depth frame's device time in seconds.
- * \throws pcl::IOException when the file is missing or not a valid recording, or when
- *         dynvo was built without OpenNI2 support
+ * The grabber's separate depth-image and image signals are used; each depth frame is
+ * paired with the colour frame nearest in time (the grabber's own image+depth
+ * synchronizer would hold back the last pair). OpenNI2 runs the file device in manual
+ * mode (playback speed -1, repeat off) and next() steps it, so reading is not paced by
+ * the recorded clock: about 10 ms per 640x480 frame on a loaded 2-core machine.
+ *
+ * Each Frame has:
+ * - timestamp: the depth frame's device time in seconds (OpenNI's player starts the
+ *   recording's clock at 0 for the first frame);
+ * - name: "<file>#<index>" (0-based frame index);
+ * - depth: metres (OpenNI millimetres x 0.001), NaN where OpenNI reports 0;
+ * - color: RGB8 at the depth resolution (PCL subsamples by an integer factor if the
+ *   colour stream is larger);
+ * - cloud: organized PointXYZRGB made from depth and colour with the grabber's own
+ *   projection model for its XYZRGBA clouds (fx = fy from the depth stream's
+ *   horizontal field of view, cx = (width - 1) / 2, cy = (height - 1) / 2; 525 px at
+ *   VGA when the recording carries no field of view, with a PCL_WARN).
+ *
+ * size() is the recording's depth frame count. The device must be an OpenNI2 file
+ * device with depth and colour streams.
+ * \throws pcl::IOException naming the file when it is missing, not a regular file,
+ *         does not start with the ONI magic "NI10" (checked before OpenNI2 sees it),
+ *         cannot be played, or when dynvo was built without OpenNI2 support. next()
+ *         throws when a frame cannot be read or playback delivers nothing for 10 s
+ *         (e.g. a truncated recording).
  */
 class DYNVO_EXPORTS OniFileSource : public FrameSource {
 public:

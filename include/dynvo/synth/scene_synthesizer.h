@@ -43,7 +43,7 @@ struct SynthFrame {
 };
 
 /// Options of a synthetic sequence.
-struct SynthOptions {
+struct DYNVO_EXPORTS SynthOptions {
   std::string scenario = "moving_crossing"; ///< one of SceneSynthesizer::scenarios()
   int frames = 300;                         ///< number of frames (> 0)
   std::uint32_t seed = 0;                   ///< seeds textures' jitter and the depth noise
@@ -61,8 +61,8 @@ struct SynthOptions {
 
 /** \brief Renders scripted dynamic scenes by ray casting (deterministic for a seed).
  *
- * World frame: x right, y down (floor at y = +1.4), z forward, metres. The room spans
- * [-2.5, 2.5] x [-1.6, 1.4] x [-1.0, 4.2] and holds two static furniture boxes; the
+ * World frame: x right, y down (floor at y = +1.0), z forward, metres. The room spans
+ * [-2.0, 2.0] x [-1.3, 1.0] x [-1.0, 2.2] and holds two static furniture boxes; the
  * scripted objects are oriented boxes. Every pixel casts one ray through its centre; the
  * depth is the hit point's z in the camera frame (TUM convention, not the range).
  *
@@ -88,7 +88,8 @@ struct SynthOptions {
  * are a hash of (seed, frame, pixel), so render(k) does not depend on call order or
  * threads. Without noise the depth is the exact ray depth everywhere.
  *
- * Timestamps: colour stamp FIRST_STAMP + k / fps, depth stamp DEPTH_STAMP_DELAY later;
+ * Timestamps: colour stamp FIRST_STAMP + k / fps, depth stamp DEPTH_STAMP_DELAY later,
+ * both rounded to whole microseconds (the "%.6f" of the files parses back exactly);
  * the depth image shows the scene at the colour stamp (a synchronised, registered sensor).
  *
  * \code

@@ -1,0 +1,140 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// dynvo_odometry: camera trajectory, moving-object masks and object motions of a recording.
+#include <dynvo/app/cli.h>
+#include <dynvo/app/frame_source_args.h>
+#include <dynvo/app/odometry_pipeline.h>
+#include <dynvo/app/pipeline_config.h>
+#include <dynvo/app/run_report.h>
+#include <dynvo/eval/trajectory_metrics.h>
+#include <dynvo/io/label_io.h>
+#include <dynvo/io/trajectory_io.h>
+
+#include <pcl/console/print.h>
+#include <pcl/exceptions.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+namespace {
+
+namespace fs = std::filesystem;
+using dynvo::app::UsageError;
+
+const char* const USAGE =
+    "dynvo_odometry (-tum_dir DIR | -pcd_dir DIR | -oni FILE) [-out trajectory.txt] "
+    "[-labels_dir DIR] [-objects FILE] [options]";
+
+std::vector<dynvo::app::Option>
+options()
+{
+  auto list = dynvo::app::frameSourceOptions();
+  list.insert(list.end(), {
+      {"out", "FILE", "TUM trajectory to write (camera-to-world; first pose identity)"},
+      {"init_gt", "", "start from the first ground-truth pose (needs groundtruth.txt)"},
+      {"labels_dir", "DIR", "write <stamp>.png per frame: 0 none, 1 static, 2.. objects"},
+      {"objects", "FILE", "write 'timestamp id n_pixels tx ty tz qx qy qz qw' per object"},
+      {"max_frames", "N", "stop after N frames (default: all)"},
+      {"threads", "N", "worker threads (default 1); results do not depend on it"},
+      {"seed", "S", "hypothesis sampling seed (default 0)"},
+      {"no_segmentation", "", "ablation: every valid flow cell counts as static"},
+      {"refine", "none|icp|gicp", "refinement of the static registration (default none)"},
+      {"config", "FILE", "YAML with every parameter (see -write_config)"},
+      {"write_config", "FILE", "write the effective configuration as YAML and exit"},
+      {"v", "", "verbose (PCL debug messages)"},
+      {"q", "", "quiet (errors only)"},
+  });
+  return list;
+}
+
+dynvo::app::PipelineOptions
+pipelineOptions(const dynvo::app::Arguments& args)
+{
+  dynvo::app::PipelineOptions options;
+  if (args.has("config"))
+    dynvo::app::loadPipelineConfig(args.string("config"), options);
+  options.intrinsics = dynvo::app::intrinsicsFromArguments(args);
+  const long threads = args.integer("threads", options.threads);
+  const long seed = args.integer("seed", options.segmentation.seed);
+  if (threads < 1 || seed < 0)
+    throw UsageError("-threads must be >= 1 and -seed >= 0");
+  options.threads = static_cast<unsigned>(threads);
+  options.segmentation.seed = static_cast<std::uint32_t>(seed);
+  if (args.has("no_segmentation"))
+    options.use_segmentation = false;
+  const std::string refine = args.string("refine", "none");
+  const char* const methods[] = {"none", "icp", "gicp"};
+  const auto method = std::find(std::begin(methods), std::end(methods), refine);
+  if (method == std::end(methods))
+    throw UsageError("-refine must be none, icp or gicp, got '" + refine + "'");
+  if (args.has("refine"))
+    options.registration.refinement =
+        static_cast<dynvo::RegistrationRefinement>(method - std::begin(methods));
+  options.validate();
+  return options;
+}
+
+} // namespace
+
+int
+main(int argc, char** argv)
+{
+  return dynvo::app::runApp(USAGE, [&] {
+    const dynvo::app::Arguments args(argc, argv, options());
+    if (args.helpRequested()) {
+      std::printf("Usage: %s\n\n%s", USAGE, args.optionsHelp().c_str());
+      return 0;
+    }
+    if (args.has("v"))
+      pcl::console::setVerbosityLevel(pcl::console::L_DEBUG);
+    if (args.has("q"))
+      pcl::console::setVerbosityLevel(pcl::console::L_ERROR);
+    const auto options = pipelineOptions(args);
+    if (args.has("write_config")) {
+      dynvo::app::writePipelineConfig(args.string("write_config"), options);
+      std::printf("wrote %s\n", args.string("write_config").c_str());
+      return 0;
+    }
+    const long max_frames = args.integer("max_frames", 0);
+    if (max_frames < 0)
+      throw UsageError("-max_frames must be >= 0");
+
+    const std::string groundtruth_path =
+        args.has("tum_dir") ? (fs::path(args.string("tum_dir")) / "groundtruth.txt").string()
+                            : "";
+    dynvo::Trajectory groundtruth;
+    if (!groundtruth_path.empty() && fs::exists(groundtruth_path))
+      groundtruth = dynvo::readTrajectory(groundtruth_path);
+    if (args.has("init_gt") && groundtruth.empty())
+      throw UsageError("-init_gt needs a -tum_dir folder with groundtruth.txt");
+
+    auto source = dynvo::app::openFrameSource(args);
+    dynvo::app::RunOutputs outputs(args.string("out"), args.string("labels_dir"),
+                                   args.string("objects"),
+                                   args.has("init_gt") ? &groundtruth : nullptr);
+    dynvo::app::OdometryPipeline pipeline(options);
+    dynvo::app::RunReport report(max_frames > 0 ? std::min<std::size_t>(max_frames, source->size())
+                                                : source->size());
+    dynvo::Frame frame;
+    int status = 0;
+    try {
+      while ((max_frames == 0 || report.frames() < static_cast<std::size_t>(max_frames)) &&
+             source->next(frame)) {
+        const auto& result = pipeline.process(frame.cloud, frame.timestamp);
+        outputs.add(result);
+        report.add(result);
+      }
+    }
+    catch (const pcl::PCLException& e) {
+      // Keep everything computed so far: the outputs are still written below.
+      pcl::console::print_error("Error: %s (stopping after %zu frames)\n",
+                                dynvo::app::errorMessage(e).c_str(), report.frames());
+      status = 1;
+    }
+    outputs.finish();
+    report.printSummary();
+    if (!groundtruth.empty() && outputs.trajectory().size() >= 2)
+      report.printAccuracy(groundtruth, outputs.trajectory());
+    return status;
+  });
+}

@@ -1,0 +1,108 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The whole odometry: scene flow -> rigid motion segmentation -> static-only registration.
+#pragma once
+
+#include <dynvo/common/camera.h>
+#include <dynvo/common/export.h>
+#include <dynvo/motion_segmentation/rigid_motion_segmentation_parameters.h>
+#include <dynvo/registration/static_scene_registration_parameters.h>
+#include <dynvo/scene_flow/grid_scene_flow_parameters.h>
+
+#include <pcl/PointIndices.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <Eigen/Core>
+#include <Eigen/StdVector>
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace dynvo::app {
+
+/// Every knob of the pipeline: the three modules' parameters plus the pipeline's own.
+struct DYNVO_EXPORTS PipelineOptions {
+  CameraIntrinsics intrinsics;                    ///< back-projection of the input frames
+  GridSceneFlowParameters scene_flow;             ///< ALGORITHM.md §1
+  RigidMotionSegmentationParameters segmentation; ///< ALGORITHM.md §3-§6 (seed included)
+  StaticSceneRegistrationParameters registration; ///< ALGORITHM.md §7
+  bool use_segmentation = true; ///< false: ablation, every valid flow cell counts as static
+  unsigned threads = 1;         ///< worker threads; results do not depend on it
+
+  /// \throws std::invalid_argument when a module's parameters or a pipeline value are invalid
+  void
+  validate() const;
+};
+
+/// Wall-clock time of each stage of one frame (milliseconds), image decoding excluded.
+struct StageTimes {
+  double scene_flow_ms = 0.0;   ///< depth preprocessing, pyramid, LK, back-projection
+  double segmentation_ms = 0.0; ///< hypotheses, clustering, tracking
+  double registration_ms = 0.0; ///< static-only ego-motion
+  double total_ms = 0.0;        ///< the whole frame
+};
+
+/// Everything the pipeline knows about one frame.
+struct FrameResult {
+  double timestamp = 0.0; ///< seconds
+  Eigen::Matrix4d T_world_curr = Eigen::Matrix4d::Identity(); ///< camera pose (camera-to-world)
+  Eigen::Matrix4d T_curr_prev = Eigen::Matrix4d::Identity();  ///< ego-motion H_k (identity at frame 0)
+  bool lost = false; ///< too few static cells: T_curr_prev is the constant-velocity prediction
+  /// segments[0] = static background pixels, then moving objects (pcl::PointIndices each)
+  std::vector<pcl::PointIndices> segments;
+  std::vector<std::uint8_t> segment_labels; ///< label id of each segment (1 = static)
+  /// T_curr_prev of each segment (metres): objects' frame-to-frame motion in the current frame
+  std::vector<Eigen::Matrix4f, Eigen::aligned_allocator<Eigen::Matrix4f>> motions;
+  std::uint32_t width = 0;          ///< image columns (px)
+  std::uint32_t height = 0;         ///< image rows (px)
+  std::vector<std::uint8_t> labels; ///< per pixel: 0 no measurement, 1 static, 2.. objects
+  StageTimes times;                 ///< stage timings
+};
+
+/** \brief Chains GridSceneFlowEstimation, RigidMotionSegmentation and StaticSceneRegistration
+ * over a sequence and composes the camera poses (T_world_curr = T_world_prev * T_prev_curr;
+ * frame 0 is the world frame).
+ * \code
+ * dynvo::app::PipelineOptions options;
+ * options.intrinsics = dynvo::CameraIntrinsics::fromPreset("fr1");
+ * dynvo::app::OdometryPipeline pipeline(options);
+ * dynvo::Frame frame;
+ * while (source.next(frame)) {
+ *   const auto& result = pipeline.process(frame.cloud, frame.timestamp);
+ *   std::cout << result.T_world_curr << (result.lost ? " (lost)" : "") << "\n";
+ * }
+ * \endcode
+ */
+class DYNVO_EXPORTS OdometryPipeline {
+public:
+  /// \throws std::invalid_argument when options.validate() fails
+  explicit OdometryPipeline(const PipelineOptions& options);
+  ~OdometryPipeline();
+  OdometryPipeline(const OdometryPipeline&) = delete;
+  OdometryPipeline&
+  operator=(const OdometryPipeline&) = delete;
+
+  /** \brief Processes the next frame of the sequence.
+   * \param[in] cloud organized frame (metres, NaN where no depth), same size every frame
+   * \param[in] timestamp seconds
+   * \return the frame's result, valid until the next call
+   * \throws std::invalid_argument when the cloud is null, unorganized or changes size
+   */
+  const FrameResult&
+  process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& cloud, double timestamp);
+
+  /// Forgets the sequence: the next frame becomes frame 0 again.
+  void
+  reset();
+
+  /// Frames processed since construction or reset().
+  std::size_t
+  frameCount() const;
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+} // namespace dynvo::app

@@ -1,0 +1,91 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// What an odometry run writes (trajectory, label images, object motions) and prints.
+#pragma once
+
+#include <dynvo/app/odometry_pipeline.h>
+#include <dynvo/io/trajectory_io.h>
+
+#include <cstddef>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace dynvo::app {
+
+/** \brief The files of a run. Label images are written as frames arrive; the trajectory and
+ * the objects file are written beside their destination and moved into place by finish(), so
+ * an interrupted run leaves earlier files untouched and what was computed is never lost.
+ */
+class DYNVO_EXPORTS RunOutputs {
+public:
+  /** \param[in] trajectory_path TUM trajectory ("" = none)
+   * \param[in] labels_dir folder for "<stamp>.png" label images ("" = none); created if needed
+   * \param[in] objects_path object-motion lines ("" = none)
+   * \param[in] initial_groundtruth when set, poses start at its pose nearest the first frame
+   * \throws pcl::IOException when a folder or file cannot be created
+   */
+  RunOutputs(const std::string& trajectory_path,
+             const std::string& labels_dir,
+             const std::string& objects_path,
+             const Trajectory* initial_groundtruth = nullptr);
+
+  /// Records one frame. \throws pcl::IOException when a file cannot be written
+  void
+  add(const FrameResult& result);
+
+  /// Writes the trajectory and moves the objects file into place.
+  void
+  finish();
+
+  /// Camera poses so far (camera-to-world).
+  const Trajectory&
+  trajectory() const
+  {
+    return trajectory_;
+  }
+
+private:
+  std::string trajectory_path_;
+  std::string labels_dir_;
+  std::string objects_path_;
+  const Trajectory* initial_groundtruth_;
+  Eigen::Isometry3d T_world_start_ = Eigen::Isometry3d::Identity();
+  std::ofstream objects_;
+  Trajectory trajectory_;
+};
+
+/// Progress bar on a terminal, per-frame timings, and the closing lines of a run.
+class DYNVO_EXPORTS RunReport {
+public:
+  /// \param[in] expected_frames frames the run will process (0 = unknown)
+  explicit RunReport(std::size_t expected_frames);
+
+  /// Records one frame (frame 0 only prepares the pipeline and is not timed).
+  void
+  add(const FrameResult& result);
+
+  /// Frames recorded.
+  std::size_t
+  frames() const
+  {
+    return frames_;
+  }
+
+  /// Prints the per-stage medians and
+  /// "frames=<n> lost=<n> median_ms=<x> mean_ms=<x> fps=<x>" (per frame, decoding excluded).
+  void
+  printSummary() const;
+
+  /// Prints the dynvo_evaluate line of the estimate against the ground truth.
+  static void
+  printAccuracy(const Trajectory& groundtruth, const Trajectory& estimate);
+
+private:
+  std::size_t expected_frames_;
+  std::size_t frames_ = 0;
+  std::size_t lost_ = 0;
+  bool terminal_;
+  std::vector<double> total_ms_, flow_ms_, segmentation_ms_, registration_ms_;
+};
+
+} // namespace dynvo::app

@@ -1,0 +1,43 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Per-frame label images and object-motion lines, as written by the segmentation apps.
+#pragma once
+
+#include <dynvo/common/export.h>
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace dynvo {
+
+/// Per-pixel labels of one frame: 0 no measurement, 1 static background, 2.. moving objects.
+struct LabelImage {
+  std::uint32_t width = 0;          ///< columns (px)
+  std::uint32_t height = 0;         ///< rows (px)
+  std::vector<std::uint8_t> data;   ///< width * height labels, row-major
+};
+
+/// File name of a frame's label image: "<timestamp %.6f>.png".
+DYNVO_EXPORTS std::string
+labelFileName(double timestamp);
+
+/// Writes an 8-bit single-channel PNG. \throws pcl::IOException naming the file on failure
+DYNVO_EXPORTS void
+writeLabelImage(const std::string& path, const LabelImage& labels);
+
+/// Reads an 8-bit single-channel PNG. \throws pcl::IOException naming the file and problem
+DYNVO_EXPORTS LabelImage
+readLabelImage(const std::string& path);
+
+/** \brief One line of an objects file: "timestamp id n_pixels tx ty tz qx qy qz qw", where the
+ * pose is the object's frame-to-frame motion T_curr_prev (metres) in the current camera frame.
+ */
+DYNVO_EXPORTS std::string
+formatObjectMotionLine(double timestamp,
+                       int id,
+                       std::size_t pixels,
+                       const Eigen::Matrix4f& T_curr_prev);
+
+} // namespace dynvo

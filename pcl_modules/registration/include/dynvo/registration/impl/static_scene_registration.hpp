@@ -1,0 +1,234 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Template bodies of StaticSceneRegistration (compiled in src/ for XYZRGB and XYZRGBA).
+#pragma once
+
+#include <dynvo/common/rigid_fit.h>
+#include <dynvo/registration/rigid_refinement.h>
+#include <dynvo/registration/static_scene_registration.h>
+
+#include <pcl/common/transforms.h>
+#include <pcl/console/print.h>
+
+#include <cmath>
+
+namespace dynvo {
+
+template <typename PointT>
+StaticSceneRegistration<PointT>::StaticSceneRegistration()
+{
+  reg_name_ = "StaticSceneRegistration";
+  // The flow gives the correspondences: never build the base class's kd-tree on the target.
+  Base::setSearchMethodTarget(Base::getSearchMethodTarget(), true);
+}
+
+template <typename PointT>
+void
+StaticSceneRegistration<PointT>::resetResults(const Matrix4& guess)
+{
+  converged_ = false;
+  final_transformation_ = guess;
+  transformation_ = guess;
+  flow_transformation_ = guess;
+  status_ = Status::invalid_input;
+  fitness_ = std::numeric_limits<double>::max();
+  inlier_count_ = 0;
+  source_points_.clear();
+  target_points_.clear();
+  weights_.clear();
+  inliers_.clear();
+}
+
+template <typename PointT>
+void
+StaticSceneRegistration<PointT>::align(PointCloud& output, const Matrix4& guess)
+{
+  output.clear();
+  resetResults(guess);
+  // Checked before the base class copies the indexed points, which it does unchecked.
+  if (!validateInputs())
+    return;
+  Base::align(output, guess);
+}
+
+template <typename PointT>
+bool
+StaticSceneRegistration<PointT>::validateInputs() const
+{
+  const char* name = reg_name_.c_str();
+  if (!input_ || !target_ || !flow_) {
+    PCL_ERROR("[dynvo::%s::align] %s not set.\n", name,
+              !input_ ? "source (current) cloud" : !target_ ? "target (previous) cloud"
+                                                           : "flow grid (setInputFlow)");
+    return false;
+  }
+  if (!input_->isOrganized() || !target_->isOrganized() || !flow_->isOrganized()) {
+    PCL_ERROR("[dynvo::%s::align] %s is not organized.\n", name,
+              !input_->isOrganized() ? "source (current) cloud"
+              : !target_->isOrganized() ? "target (previous) cloud"
+                                        : "flow grid");
+    return false;
+  }
+  if (input_->width != target_->width || input_->height != target_->height) {
+    PCL_ERROR("[dynvo::%s::align] source cloud is %ux%u but target cloud is %ux%u.\n", name,
+              input_->width, input_->height, target_->width, target_->height);
+    return false;
+  }
+  const std::uint32_t cell = flow_->width > 0 ? input_->width / flow_->width : 0;
+  if (cell == 0 || input_->height / cell != flow_->height) {
+    PCL_ERROR("[dynvo::%s::align] a %ux%u flow grid does not tile a %ux%u cloud "
+              "(cell size = width / flow width).\n",
+              name, flow_->width, flow_->height, input_->width, input_->height);
+    return false;
+  }
+  if (indices_ && !fake_indices_) {
+    for (const auto index : *indices_) {
+      if (index < 0 || static_cast<std::size_t>(index) >= input_->size()) {
+        PCL_ERROR("[dynvo::%s::align] index %d is outside the %zu-point source cloud.\n", name,
+                  static_cast<int>(index), input_->size());
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+template <typename PointT>
+void
+StaticSceneRegistration<PointT>::collectCorrespondences()
+{
+  const std::size_t width = input_->width;
+  const std::size_t grid_width = flow_->width;
+  const std::size_t grid_height = flow_->height;
+  const std::size_t cell = width / grid_width;
+  static_cells_.assign(flow_->size(), 0);
+  for (const auto index : *indices_) {
+    const std::size_t col = static_cast<std::size_t>(index) % width / cell;
+    const std::size_t row = static_cast<std::size_t>(index) / width / cell;
+    if (col < grid_width && row < grid_height)
+      static_cells_[row * grid_width + col] = 1;
+  }
+  for (std::size_t i = 0; i < flow_->size(); ++i) {
+    const PointFlow& f = (*flow_)[i];
+    const Eigen::Vector3d b(f.x, f.y, f.z);
+    const Eigen::Vector3d a(f.prev_x, f.prev_y, f.prev_z);
+    if (!static_cells_[i] || !f.valid_3d || !(f.weight > 0.0f) || !std::isfinite(f.weight) ||
+        !b.allFinite() || !a.allFinite())
+      continue;
+    source_points_.push_back(b);
+    target_points_.push_back(a);
+    weights_.push_back(f.weight);
+  }
+}
+
+template <typename PointT>
+bool
+StaticSceneRegistration<PointT>::estimateFromFlow()
+{
+  const std::size_t count = source_points_.size();
+  const auto min_count = static_cast<std::size_t>(params_.min_correspondences);
+  if (count < min_count) {
+    status_ = Status::too_few_correspondences;
+    PCL_DEBUG("[dynvo::%s::align] %zu static cells, fewer than %zu.\n", reg_name_.c_str(),
+              count, min_count);
+    return false;
+  }
+  RigidFitAccumulator fit;
+  for (std::size_t i = 0; i < count; ++i)
+    fit.add(source_points_[i], target_points_[i], weights_[i]);
+  Eigen::Matrix4d T_prev_curr;
+  if (fit.solve(T_prev_curr) != RigidFitStatus::ok) {
+    status_ = Status::degenerate;
+    PCL_DEBUG("[dynvo::%s::align] the %zu static cells are collinear.\n", reg_name_.c_str(),
+              count);
+    return false;
+  }
+  inliers_.assign(count, 1);
+  inlier_count_ = count;
+  // ALGORITHM.md §7: keep E_i <= trim_factor * th_inlier and refit, trim_rounds times.
+  const double trim_threshold =
+      static_cast<double>(params_.trim_factor) * static_cast<double>(params_.th_inlier);
+  std::vector<std::uint8_t> kept(count);
+  for (int round = 0; round < params_.trim_rounds; ++round) {
+    fit.clear();
+    for (std::size_t i = 0; i < count; ++i) {
+      kept[i] = squaredTransferError(T_prev_curr, source_points_[i], target_points_[i]) <=
+                trim_threshold;
+      if (kept[i])
+        fit.add(source_points_[i], target_points_[i], weights_[i]);
+    }
+    if (fit.size() < min_count || fit.solve(T_prev_curr) != RigidFitStatus::ok)
+      break;
+    inliers_ = kept;
+    inlier_count_ = fit.size();
+  }
+  flow_transformation_ = T_prev_curr.cast<float>();
+  return true;
+}
+
+template <typename PointT>
+bool
+StaticSceneRegistration<PointT>::refine(Matrix4& refined) const
+{
+  const std::size_t stride = static_cast<std::size_t>(params_.refinement_stride);
+  const std::size_t width = input_->width;
+  const auto on_lattice = [stride, width](std::size_t index) {
+    return index % width % stride == 0 && index / width % stride == 0;
+  };
+  pcl::PointCloud<pcl::PointXYZ>::Ptr source(new pcl::PointCloud<pcl::PointXYZ>);
+  for (const auto index : *indices_) {
+    const PointT& p = (*input_)[index];
+    if (on_lattice(static_cast<std::size_t>(index)) && pcl::isXYZFinite(p))
+      source->push_back(pcl::PointXYZ(p.x, p.y, p.z));
+  }
+  pcl::PointCloud<pcl::PointXYZ>::Ptr target(new pcl::PointCloud<pcl::PointXYZ>);
+  for (std::size_t index = 0; index < target_->size(); ++index) {
+    const PointT& p = (*target_)[index];
+    if (on_lattice(index) && pcl::isXYZFinite(p))
+      target->push_back(pcl::PointXYZ(p.x, p.y, p.z));
+  }
+  const auto min_count = static_cast<std::size_t>(params_.min_correspondences);
+  if (source->size() < min_count || target->size() < min_count) {
+    PCL_DEBUG("[dynvo::%s::align] %zu source / %zu target points on the refinement lattice.\n",
+              reg_name_.c_str(), source->size(), target->size());
+    return false;
+  }
+  return detail::refineRigidTransformation(
+      source, target, params_.refinement, params_, flow_transformation_, refined);
+}
+
+template <typename PointT>
+void
+StaticSceneRegistration<PointT>::computeTransformation(PointCloud& output, const Matrix4& guess)
+{
+  resetResults(guess);
+  // Repeated here for calls through a pcl::Registration reference, which bypass align().
+  if (!validateInputs()) {
+    output.clear();
+    return;
+  }
+  collectCorrespondences();
+  if (!estimateFromFlow()) {
+    output.clear();
+    return;
+  }
+  converged_ = true;
+  status_ = Status::converged;
+  final_transformation_ = flow_transformation_;
+  if (params_.refinement != Refinement::none) {
+    Matrix4 refined;
+    if (refine(refined))
+      final_transformation_ = refined;
+    else
+      status_ = Status::refinement_not_converged;
+  }
+  transformation_ = final_transformation_;
+  const Eigen::Matrix4d T_final = final_transformation_.template cast<double>();
+  double residual_sum = 0.0;
+  for (std::size_t i = 0; i < source_points_.size(); ++i)
+    if (inliers_[i])
+      residual_sum += squaredTransferError(T_final, source_points_[i], target_points_[i]);
+  fitness_ = residual_sum / static_cast<double>(inlier_count_);
+  pcl::transformPointCloud(output, output, final_transformation_);
+}
+
+} // namespace dynvo

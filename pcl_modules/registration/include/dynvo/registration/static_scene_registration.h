@@ -1,0 +1,263 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Ego-motion from the static part of the scene (ALGORITHM.md §7) as a pcl::Registration.
+#pragma once
+
+#include <dynvo/common/export.h>
+#include <dynvo/common/point_types.h>
+#include <dynvo/registration/static_scene_registration_parameters.h>
+
+#include <pcl/point_cloud.h>
+#include <pcl/registration/registration.h>
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace dynvo {
+
+/// What the last align() produced (StaticSceneRegistration::getStatus()).
+enum class StaticRegistrationStatus {
+  not_computed,            ///< align() has not run yet
+  invalid_input,           ///< the inputs broke the contract (logged with PCL_ERROR); not converged
+  too_few_correspondences, ///< fewer than min_correspondences usable static cells; not converged
+  degenerate,              ///< the static cells are (nearly) collinear; not converged
+  converged,               ///< the result is the trimmed flow estimate, refined if refinement != none
+  refinement_not_converged ///< converged, but ICP/GICP failed: the result is the flow estimate
+};
+
+/** \brief Camera ego-motion from the static cells of a grid scene flow: Lee, Son & Kim, "Robust
+ * Real-time RGB-D Visual Odometry in Dynamic Environments via Rigid Motion Model", IROS 2019
+ * (arXiv 1907.08388), §III-D; ALGORITHM.md §7.
+ *
+ * PCL's naming applies: the source (setInputSource) is the current frame k, setIndices() holds
+ * its static pixels (linear indices row * width + col), the target (setInputTarget) is the
+ * previous frame k-1, and getFinalTransformation() is T_prev_curr (the inverse of the paper's
+ * H_k); a pipeline composes T_world_curr = T_world_prev * T_prev_curr.
+ *
+ * Flow estimate (no nearest-neighbour search): the flow grid (setInputFlow, from
+ * GridSceneFlowEstimation on the same frame pair) gives per cell b_i (x, y, z; current frame)
+ * and a_i (prev_x, prev_y, prev_z; previous frame). Cell geometry: cell_size = width / flow.width
+ * (integer division), and height / cell_size must equal flow.height. A static pixel (col, row)
+ * selects the cell (col / cell_size, row / cell_size); pixels right of or below the last full
+ * cell select none, and a cell counts once however many of its pixels are listed (cell centres
+ * alone or whole cells both work). Without setIndices() every cell counts as static. The set S
+ * holds the selected cells with valid_3d, finite a_i and b_i and weight > 0. The weighted
+ * least-squares rigid fit (RigidFitAccumulator, weights = flow weights) maps b_i onto a_i; then
+ * trim_rounds rounds keep the cells of S with E_i <= trim_factor * th_inlier and refit; a round
+ * leaving fewer than min_correspondences cells, or a degenerate refit, keeps the previous fit.
+ *
+ * Refinement (optional): ICP or GICP on plain XYZ copies of the static points of the source
+ * (every refinement_stride-th row and column) against the finite points of the whole target on
+ * the same lattice, initialised with the flow estimate. Moving objects in the previous frame are
+ * kept out only by refinement_max_correspondence_distance.
+ *
+ * Results: hasConverged() is false for invalid input, too few cells (|S| < min_correspondences)
+ * and degenerate cells; getStatus() says which, and getFinalTransformation() is then the guess
+ * passed to align() (identity by default), so a pipeline can pass its constant-velocity
+ * prediction and flag the frame as lost. getFitnessScore() is the mean squared residual E_i (m^2)
+ * of the kept cells under the final transformation (also after refinement).
+ * getNumberOfCorrespondences() is |S|, getNumberOfInliers() the number of kept cells.
+ * The output cloud of align() holds the static points transformed into the previous frame; it is
+ * unorganized once indices are set (PCL's registration.hpp) and empty when not converged.
+ *
+ * pcl::Registration's own knobs (setMaximumIterations, setMaxCorrespondenceDistance, the
+ * correspondence estimation and rejectors) are not used: see Parameters. No kd-tree is ever
+ * built, so call getFitnessScore() on this class; the base's getFitnessScore(max_range) would
+ * search an empty tree. Call align() on this class too: the base's align() skips the dynvo
+ * input checks and does not range-check the indices.
+ * \code
+ * dynvo::StaticSceneRegistration<pcl::PointXYZRGB> registration;
+ * registration.setInputSource(current);               // frame k
+ * registration.setInputTarget(previous);              // frame k-1
+ * registration.setIndices(static_indices);            // e.g. segments[0] of the segmentation
+ * registration.setInputFlow(flow);                    // grid scene flow k-1 -> k
+ * pcl::PointCloud<pcl::PointXYZRGB> aligned;
+ * registration.align(aligned, T_prev_curr_predicted); // the guess is returned when not converged
+ * if (registration.hasConverged()) T_world_curr = T_world_prev * registration.getFinalTransformation();
+ * \endcode
+ * Not thread-safe; separate instances may run concurrently. Explicitly instantiated for
+ * pcl::PointXYZRGB and pcl::PointXYZRGBA (other types: include the impl .hpp).
+ */
+template <typename PointT>
+class StaticSceneRegistration : public pcl::Registration<PointT, PointT, float> {
+public:
+  using Base = pcl::Registration<PointT, PointT, float>;
+  using PointCloud = pcl::PointCloud<PointT>;
+  using PointCloudPtr = typename PointCloud::Ptr;
+  using PointCloudConstPtr = typename PointCloud::ConstPtr;
+  using Ptr = pcl::shared_ptr<StaticSceneRegistration<PointT>>;
+  using ConstPtr = pcl::shared_ptr<const StaticSceneRegistration<PointT>>;
+  using FlowCloud = pcl::PointCloud<PointFlow>;
+  using FlowCloudConstPtr = FlowCloud::ConstPtr;
+  using Matrix4 = typename Base::Matrix4;
+  using Parameters = StaticSceneRegistrationParameters;
+  using Refinement = RegistrationRefinement;
+  using Status = StaticRegistrationStatus;
+
+  /// Sets the class name and disables the base class's kd-tree on the target.
+  StaticSceneRegistration();
+
+  /// Grid scene flow from the target (frame k-1) to the source (frame k), organized Gx x Gy.
+  void
+  setInputFlow(const FlowCloudConstPtr& flow)
+  {
+    flow_ = flow;
+  }
+
+  const FlowCloudConstPtr&
+  getInputFlow() const
+  {
+    return flow_;
+  }
+
+  /// Estimates T_prev_curr; see the class doc. \param[out] output static points, moved
+  void
+  align(PointCloud& output)
+  {
+    align(output, Matrix4::Identity());
+  }
+
+  /** \brief Estimates T_prev_curr; see the class doc.
+   * \param[out] output static points of the source moved into the target frame (unorganized)
+   * \param[in] guess T_prev_curr returned by getFinalTransformation() when not converged
+   */
+  void
+  align(PointCloud& output, const Matrix4& guess);
+
+  /// Mean squared residual E_i (m^2) of the kept cells under the final transformation;
+  /// std::numeric_limits<double>::max() when not converged.
+  double
+  getFitnessScore() const
+  {
+    return fitness_;
+  }
+
+  /// |S|: usable static cells of the last align() (0 for invalid input).
+  std::size_t
+  getNumberOfCorrespondences() const
+  {
+    return source_points_.size();
+  }
+
+  /// Cells kept by the trimming (the ones the flow estimate was fitted on).
+  std::size_t
+  getNumberOfInliers() const
+  {
+    return inlier_count_;
+  }
+
+  Status
+  getStatus() const
+  {
+    return status_;
+  }
+
+  /// T_prev_curr of the trimmed flow estimate, before any refinement (the guess when it failed).
+  const Matrix4&
+  getFlowTransformation() const
+  {
+    return flow_transformation_;
+  }
+
+  /// All knobs at once. \throws std::invalid_argument when parameters.validate() fails
+  void
+  setParameters(const Parameters& parameters)
+  {
+    parameters.validate();
+    params_ = parameters;
+  }
+
+  const Parameters&
+  getParameters() const
+  {
+    return params_;
+  }
+
+  // One setter/getter pair per field of Parameters; each throws std::invalid_argument on a
+  // value out of the range documented in StaticSceneRegistrationParameters.
+  void setInlierThreshold(float m2) { updateField(&Parameters::th_inlier, m2); }
+  float getInlierThreshold() const { return params_.th_inlier; }
+  void setTrimFactor(float factor) { updateField(&Parameters::trim_factor, factor); }
+  float getTrimFactor() const { return params_.trim_factor; }
+  void setTrimRounds(int rounds) { updateField(&Parameters::trim_rounds, rounds); }
+  int getTrimRounds() const { return params_.trim_rounds; }
+  void setMinCorrespondences(int cells) { updateField(&Parameters::min_correspondences, cells); }
+  int getMinCorrespondences() const { return params_.min_correspondences; }
+  void setRefinement(Refinement method) { updateField(&Parameters::refinement, method); }
+  Refinement getRefinement() const { return params_.refinement; }
+  void setRefinementMaxCorrespondenceDistance(double metres) { updateField(&Parameters::refinement_max_correspondence_distance, metres); }
+  double getRefinementMaxCorrespondenceDistance() const { return params_.refinement_max_correspondence_distance; }
+  void setRefinementMaxIterations(int iterations) { updateField(&Parameters::refinement_max_iterations, iterations); }
+  int getRefinementMaxIterations() const { return params_.refinement_max_iterations; }
+  void setRefinementTransformationEpsilon(double m2) { updateField(&Parameters::refinement_transformation_epsilon, m2); }
+  double getRefinementTransformationEpsilon() const { return params_.refinement_transformation_epsilon; }
+  void setRefinementStride(int px) { updateField(&Parameters::refinement_stride, px); }
+  int getRefinementStride() const { return params_.refinement_stride; }
+
+protected:
+  using Base::converged_;
+  using Base::fake_indices_;
+  using Base::final_transformation_;
+  using Base::indices_;
+  using Base::input_;
+  using Base::reg_name_;
+  using Base::target_;
+  using Base::transformation_;
+
+  /// Runs the flow estimate and the optional refinement (called by pcl::Registration::align).
+  void
+  computeTransformation(PointCloud& output, const Matrix4& guess) override;
+
+  /// Non-null organized source, target and flow; equal source and target sizes; a flow grid
+  /// matching the cloud (see the class doc); indices in range. Logs PCL_ERROR otherwise.
+  bool
+  validateInputs() const;
+
+  /// Collects S from the indices and the flow (fills source_points_, target_points_, weights_).
+  void
+  collectCorrespondences();
+
+  /// Weighted fit on S, then trimming. Sets status_, flow_transformation_ and inliers_.
+  bool
+  estimateFromFlow();
+
+  /// ICP/GICP from flow_transformation_; true and writes refined when PCL reports convergence.
+  bool
+  refine(Matrix4& refined) const;
+
+private:
+  template <typename Field>
+  void
+  updateField(Field Parameters::*field, Field value)
+  {
+    Parameters updated = params_;
+    updated.*field = value;
+    setParameters(updated);
+  }
+
+  /// Clears every result; the final transformation becomes the guess.
+  void
+  resetResults(const Matrix4& guess);
+
+  Parameters params_;                          ///< validated knobs
+  FlowCloudConstPtr flow_;                     ///< grid scene flow k-1 -> k
+  Status status_ = Status::not_computed;       ///< outcome of the last align()
+  double fitness_ = std::numeric_limits<double>::max(); ///< mean kept E_i (m^2)
+  Matrix4 flow_transformation_ = Matrix4::Identity();   ///< trimmed flow estimate T_prev_curr
+  std::size_t inlier_count_ = 0;               ///< cells the flow estimate was fitted on
+  std::vector<Eigen::Vector3d> source_points_; ///< b_i of S (metres, current frame)
+  std::vector<Eigen::Vector3d> target_points_; ///< a_i of S (metres, previous frame)
+  std::vector<double> weights_;                ///< flow weight of each cell of S
+  std::vector<std::uint8_t> inliers_;          ///< 1 for the cells of S kept by the trimming
+  std::vector<std::uint8_t> static_cells_;     ///< per grid cell: selected by an index
+};
+
+} // namespace dynvo
+
+#ifdef DYNVO_NO_PRECOMPILE
+#include <dynvo/registration/impl/static_scene_registration.hpp>
+#endif

@@ -1,0 +1,493 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <dynvo/registration/static_scene_registration.h>
+
+#include "box_scene.h"
+
+#include <pcl/point_types.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace {
+
+using dynvo::StaticRegistrationStatus;
+using dynvo::test::BoxScene;
+using dynvo::test::cellPixels;
+using dynvo::test::rotationErrorDeg;
+using dynvo::test::translationError;
+
+constexpr std::uint32_t CELL = 16; // w_grid (px), ALGORITHM.md §0
+
+// Noise-free correspondences are float copies of exact points at <= 4 m: round-off is
+// ~2e-7 m per coordinate, so 1 mm and 0.05 degrees (the brief's accuracy) leave a margin of
+// three orders of magnitude while still failing on any systematic error such as a swapped
+// direction (2 degrees / 3.7 cm here) or an untrimmed outlier bias (> 1 mm, checked below).
+constexpr double TRANSLATION_TOL = 1e-3; // metres
+constexpr double ROTATION_TOL = 0.05;    // degrees
+
+/// A frame pair of the box scene with its flow grid and the static cells.
+template <typename PointT>
+struct FramePair {
+  dynvo::test::RenderedFrame<PointT> previous;
+  dynvo::test::RenderedFrame<PointT> current;
+  pcl::PointCloud<dynvo::PointFlow>::Ptr flow;
+  std::vector<std::uint8_t> static_cells;
+  std::uint32_t cols = 0;
+
+  explicit FramePair(const BoxScene& scene)
+  : previous(scene.render<PointT>(false)), current(scene.render<PointT>(true))
+  {
+    flow.reset(new pcl::PointCloud<dynvo::PointFlow>(scene.flow(current, CELL, static_cells)));
+    cols = scene.width / CELL;
+  }
+
+  /// Every pixel of the static cells.
+  pcl::PointIndices::Ptr
+  staticPixels(std::uint32_t width) const
+  {
+    return cellPixels(static_cells, cols, CELL, width);
+  }
+
+  /// The pixels of the static cells that see a static box (cells at the moving box's border
+  /// also hold some of its pixels, which a point-based refinement must not get).
+  pcl::PointIndices::Ptr
+  staticSurfacePixels(const BoxScene& scene) const
+  {
+    pcl::PointIndices::Ptr indices = staticPixels(scene.width);
+    auto& list = indices->indices;
+    list.erase(std::remove_if(list.begin(), list.end(),
+                              [&](int index) {
+                                const int box = current.box[static_cast<std::size_t>(index)];
+                                return box < 0 || scene.boxes[box].moving;
+                              }),
+               list.end());
+    return indices;
+  }
+
+  std::size_t
+  staticCellCount() const
+  {
+    std::size_t n = 0;
+    for (const auto s : static_cells)
+      n += s;
+    return n;
+  }
+};
+
+template <typename PointT>
+class StaticSceneRegistrationTyped : public ::testing::Test {};
+using PointTypes = ::testing::Types<pcl::PointXYZRGB, pcl::PointXYZRGBA>;
+TYPED_TEST_SUITE(StaticSceneRegistrationTyped, PointTypes);
+
+TYPED_TEST(StaticSceneRegistrationTyped, SameFrameTwiceGivesIdentity)
+{
+  BoxScene scene = BoxScene::make();
+  scene.T_curr_prev.setIdentity();
+  scene.object_motion.setIdentity();
+  const FramePair<TypeParam> pair(scene);
+  dynvo::StaticSceneRegistration<TypeParam> registration;
+  registration.setInputSource(pair.current.cloud);
+  registration.setInputTarget(pair.current.cloud);
+  registration.setIndices(pair.staticPixels(scene.width));
+  registration.setInputFlow(pair.flow);
+  pcl::PointCloud<TypeParam> aligned;
+  registration.align(aligned);
+  ASSERT_TRUE(registration.hasConverged());
+  EXPECT_EQ(registration.getStatus(), StaticRegistrationStatus::converged);
+  EXPECT_LT(rotationErrorDeg(registration.getFinalTransformation(), Eigen::Matrix4d::Identity()),
+            ROTATION_TOL);
+  EXPECT_LT(translationError(registration.getFinalTransformation(), Eigen::Matrix4d::Identity()),
+            TRANSLATION_TOL);
+  EXPECT_EQ(registration.getNumberOfCorrespondences(), pair.staticCellCount());
+  EXPECT_EQ(registration.getNumberOfInliers(), pair.staticCellCount());
+  // Residuals are float round-off only: (1e-5 m)^2 bounds it with a wide margin.
+  EXPECT_LT(registration.getFitnessScore(), 1e-10);
+  // align() returns the static points, unorganized (PCL's rule once indices are set).
+  EXPECT_EQ(aligned.size(), pair.staticPixels(scene.width)->indices.size());
+  EXPECT_EQ(aligned.height, 1u);
+}
+
+TYPED_TEST(StaticSceneRegistrationTyped, RecoversAKnownMotionForwardAndInverse)
+{
+  for (const bool inverse : {false, true}) {
+    BoxScene scene = BoxScene::make();
+    if (inverse)
+      scene.T_curr_prev = scene.T_curr_prev.inverse();
+    const FramePair<TypeParam> pair(scene);
+    dynvo::StaticSceneRegistration<TypeParam> registration;
+    registration.setInputSource(pair.current.cloud);
+    registration.setInputTarget(pair.previous.cloud);
+    registration.setIndices(pair.staticPixels(scene.width));
+    registration.setInputFlow(pair.flow);
+    pcl::PointCloud<TypeParam> aligned;
+    registration.align(aligned);
+    ASSERT_TRUE(registration.hasConverged()) << "inverse " << inverse;
+    // getFinalTransformation() is T_prev_curr, the inverse of the paper's H_k = T_curr_prev.
+    const Eigen::Matrix4d truth = scene.T_curr_prev.inverse().matrix();
+    EXPECT_LT(rotationErrorDeg(registration.getFinalTransformation(), truth), ROTATION_TOL)
+        << "inverse " << inverse;
+    EXPECT_LT(translationError(registration.getFinalTransformation(), truth), TRANSLATION_TOL)
+        << "inverse " << inverse;
+    // The moving box's cells were never selected, so nothing was trimmed.
+    EXPECT_EQ(registration.getNumberOfInliers(), pair.staticCellCount());
+    // Exact correspondences: the mean squared residual is round-off, below (10 um)^2.
+    EXPECT_LT(registration.getFitnessScore(), 1e-10) << "inverse " << inverse;
+  }
+}
+
+TYPED_TEST(StaticSceneRegistrationTyped, TooFewStaticCellsDoNotConverge)
+{
+  const BoxScene scene = BoxScene::make();
+  const FramePair<TypeParam> pair(scene);
+  // Keep 5 static cells: one fewer than min_correspondences = 6.
+  std::vector<std::uint8_t> few(pair.static_cells.size(), 0);
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < few.size() && kept < 5; ++i)
+    if (pair.static_cells[i]) {
+      few[i] = 1;
+      ++kept;
+    }
+  dynvo::StaticSceneRegistration<TypeParam> registration;
+  registration.setInputSource(pair.current.cloud);
+  registration.setInputTarget(pair.previous.cloud);
+  registration.setIndices(cellPixels(few, pair.cols, CELL, scene.width));
+  registration.setInputFlow(pair.flow);
+  Eigen::Matrix4f prediction = Eigen::Matrix4f::Identity();
+  prediction(0, 3) = 0.25f;
+  pcl::PointCloud<TypeParam> aligned;
+  registration.align(aligned, prediction);
+  EXPECT_FALSE(registration.hasConverged());
+  EXPECT_EQ(registration.getStatus(), StaticRegistrationStatus::too_few_correspondences);
+  EXPECT_EQ(registration.getNumberOfCorrespondences(), 5u);
+  EXPECT_EQ(registration.getFinalTransformation(), prediction);
+  EXPECT_EQ(registration.getFitnessScore(), std::numeric_limits<double>::max());
+  EXPECT_TRUE(aligned.empty());
+  // Lowering the minimum to 5 turns the same input into a converged estimate.
+  registration.setMinCorrespondences(5);
+  registration.align(aligned, prediction);
+  EXPECT_TRUE(registration.hasConverged());
+}
+
+using Point = pcl::PointXYZRGB;
+
+class StaticSceneRegistrationTest : public ::testing::Test {
+protected:
+  StaticSceneRegistrationTest() : scene_(BoxScene::make()), pair_(scene_)
+  {
+    registration_.setInputSource(pair_.current.cloud);
+    registration_.setInputTarget(pair_.previous.cloud);
+    registration_.setIndices(pair_.staticPixels(scene_.width));
+    registration_.setInputFlow(pair_.flow);
+  }
+
+  Eigen::Matrix4d
+  truth() const
+  {
+    return scene_.T_curr_prev.inverse().matrix();
+  }
+
+  /// Runs align() and returns stderr, where PCL_ERROR writes.
+  std::string
+  alignCapturingErrors()
+  {
+    ::testing::internal::CaptureStderr();
+    registration_.align(aligned_);
+    return ::testing::internal::GetCapturedStderr();
+  }
+
+  BoxScene scene_;
+  FramePair<Point> pair_;
+  dynvo::StaticSceneRegistration<Point> registration_;
+  pcl::PointCloud<Point> aligned_;
+};
+
+TEST_F(StaticSceneRegistrationTest, CellCentresAndWholeCellsSelectTheSameCells)
+{
+  pcl::PointIndices::Ptr centres(new pcl::PointIndices);
+  for (std::size_t i = 0; i < pair_.static_cells.size(); ++i)
+    if (pair_.static_cells[i]) {
+      const std::uint32_t u = (i % pair_.cols) * CELL + CELL / 2;
+      const std::uint32_t v = (i / pair_.cols) * CELL + CELL / 2;
+      centres->indices.push_back(static_cast<int>(v * scene_.width + u));
+    }
+  registration_.setIndices(centres);
+  registration_.align(aligned_);
+  ASSERT_TRUE(registration_.hasConverged());
+  EXPECT_EQ(registration_.getNumberOfCorrespondences(), pair_.staticCellCount());
+  EXPECT_LT(translationError(registration_.getFinalTransformation(), truth()), TRANSLATION_TOL);
+  EXPECT_EQ(aligned_.size(), centres->indices.size());
+}
+
+TEST_F(StaticSceneRegistrationTest, WithoutIndicesEveryValidCellCounts)
+{
+  std::size_t valid = 0;
+  for (const auto& f : *pair_.flow)
+    valid += f.valid_3d;
+  registration_.setIndices(pcl::IndicesPtr());
+  registration_.align(aligned_);
+  EXPECT_EQ(registration_.getNumberOfCorrespondences(), valid);
+  EXPECT_GT(valid, pair_.staticCellCount()); // the moving box is in S now
+}
+
+TEST_F(StaticSceneRegistrationTest, OutliersInTheStaticSetAreTrimmed)
+{
+  // Five static cells get a 5 cm error in the same direction (a bad depth or track):
+  // E = 2.5e-3 m^2 >> 4 th_inlier = 1.2e-4 m^2, so the trimming drops exactly these.
+  pcl::PointCloud<dynvo::PointFlow>::Ptr corrupted(new pcl::PointCloud<dynvo::PointFlow>(*pair_.flow));
+  int outliers = 0;
+  for (std::size_t i = 0; i < corrupted->size() && outliers < 5; i += 7)
+    if (pair_.static_cells[i]) {
+      (*corrupted)[i].prev_x += 0.05f;
+      ++outliers;
+    }
+  ASSERT_EQ(outliers, 5);
+  registration_.setInputFlow(corrupted);
+  registration_.setTrimRounds(0);
+  registration_.align(aligned_);
+  ASSERT_TRUE(registration_.hasConverged());
+  const double untrimmed = translationError(registration_.getFinalTransformation(), truth());
+  EXPECT_GT(untrimmed, TRANSLATION_TOL) << "the outliers must matter for this test to mean anything";
+  registration_.setTrimRounds(2);
+  registration_.align(aligned_);
+  ASSERT_TRUE(registration_.hasConverged());
+  EXPECT_LT(rotationErrorDeg(registration_.getFinalTransformation(), truth()), ROTATION_TOL);
+  EXPECT_LT(translationError(registration_.getFinalTransformation(), truth()), TRANSLATION_TOL);
+  EXPECT_EQ(registration_.getNumberOfInliers(), pair_.staticCellCount() - 5);
+  // The kept cells are exact, so the fitness is round-off, below (10 um)^2.
+  EXPECT_LT(registration_.getFitnessScore(), 1e-10);
+}
+
+TEST_F(StaticSceneRegistrationTest, CollinearStaticCellsAreDegenerate)
+{
+  // Cells of the top row that see the back wall: their points lie on the intersection of the
+  // wall with the viewing plane of that image row, a straight line.
+  std::vector<std::uint8_t> row(pair_.static_cells.size(), 0);
+  std::size_t n = 0;
+  for (std::uint32_t col = 0; col < pair_.cols; ++col) {
+    const std::uint32_t u = col * CELL + CELL / 2;
+    if (pair_.current.box[CELL / 2 * scene_.width + u] == 0) { // box 0 = back wall
+      row[col] = 1;
+      ++n;
+    }
+  }
+  ASSERT_GE(n, 6u);
+  registration_.setIndices(cellPixels(row, pair_.cols, CELL, scene_.width));
+  registration_.align(aligned_);
+  EXPECT_FALSE(registration_.hasConverged());
+  EXPECT_EQ(registration_.getStatus(), StaticRegistrationStatus::degenerate);
+  EXPECT_EQ(registration_.getNumberOfCorrespondences(), n);
+}
+
+/// A flow grid built with a slightly wrong motion (0.5 degrees, 1 cm): the flow estimate is off
+/// by exactly that, and the refinement must pull it back using the clouds themselves.
+class RefinementTest : public StaticSceneRegistrationTest,
+                       public ::testing::WithParamInterface<dynvo::RegistrationRefinement> {};
+
+TEST_P(RefinementTest, ConvergesFromASlightlyWrongFlowEstimate)
+{
+  scene_ = BoxScene::makeClutter();
+  // The small box stays put (it is still excluded from the indices): the disocclusions of a
+  // moving box would add NN outliers that have nothing to do with the refinement itself.
+  scene_.object_motion.setIdentity();
+  pair_ = FramePair<Point>(scene_);
+  registration_.setInputSource(pair_.current.cloud);
+  registration_.setInputTarget(pair_.previous.cloud);
+  BoxScene biased = scene_;
+  biased.T_curr_prev = dynvo::test::rigid({1.0, -0.5, 0.3}, 0.5, {0.01, 0.0, 0.0}) * scene_.T_curr_prev;
+  std::vector<std::uint8_t> unused;
+  registration_.setInputFlow(pcl::make_shared<pcl::PointCloud<dynvo::PointFlow>>(
+      biased.flow(pair_.current, CELL, unused)));
+  registration_.setIndices(pair_.staticSurfacePixels(scene_));
+  registration_.setRefinement(GetParam());
+  registration_.setRefinementStride(2);
+  registration_.align(aligned_);
+  ASSERT_TRUE(registration_.hasConverged());
+  ASSERT_EQ(registration_.getStatus(), StaticRegistrationStatus::converged);
+  const Eigen::Matrix4f& flow_estimate = registration_.getFlowTransformation();
+  const Eigen::Matrix4f& refined = registration_.getFinalTransformation();
+  EXPECT_GT(translationError(flow_estimate, truth()), 5e-3);
+  EXPECT_GT(rotationErrorDeg(flow_estimate, truth()), 0.3);
+  // State tolerance. GICP matches local planes, so the different sampling of the two frames
+  // cancels: 1 mm / 0.05 degrees as for the flow estimate (measured 0.3 mm / 0.02 degrees).
+  // Point-to-point ICP pairs each sample with the nearest sample of the other frame, 1.3-2 cm
+  // apart at 1.5-2.2 m with stride 2 at 160x120, and stays biased by a fraction of that spacing
+  // (measured 3.4 mm / 0.39 degrees): it must at least halve the 1 cm error and reduce the rotation error.
+  const bool gicp = GetParam() == dynvo::RegistrationRefinement::gicp;
+  EXPECT_LT(translationError(refined, truth()), gicp ? TRANSLATION_TOL : 5e-3);
+  EXPECT_LT(rotationErrorDeg(refined, truth()), gicp ? ROTATION_TOL : 0.45);
+}
+
+INSTANTIATE_TEST_SUITE_P(IcpAndGicp, RefinementTest,
+                         ::testing::Values(dynvo::RegistrationRefinement::icp,
+                                           dynvo::RegistrationRefinement::gicp));
+
+// --- contract ---------------------------------------------------------------------------
+
+constexpr const char* PREFIX = "[dynvo::StaticSceneRegistration::align]";
+
+TEST_F(StaticSceneRegistrationTest, MissingInputsAreLoggedAndNotConverged)
+{
+  registration_.align(aligned_);
+  ASSERT_TRUE(registration_.hasConverged()); // a good run first: nothing may stay stale
+
+  dynvo::StaticSceneRegistration<Point> empty;
+  ::testing::internal::CaptureStderr();
+  empty.align(aligned_);
+  EXPECT_NE(::testing::internal::GetCapturedStderr().find(PREFIX), std::string::npos);
+  EXPECT_FALSE(empty.hasConverged());
+  EXPECT_EQ(empty.getStatus(), StaticRegistrationStatus::invalid_input);
+  EXPECT_TRUE(aligned_.empty());
+
+  registration_.setInputFlow(nullptr);
+  const std::string log = alignCapturingErrors();
+  EXPECT_NE(log.find(PREFIX), std::string::npos) << log;
+  EXPECT_NE(log.find("flow"), std::string::npos) << log;
+  EXPECT_FALSE(registration_.hasConverged());
+  EXPECT_EQ(registration_.getStatus(), StaticRegistrationStatus::invalid_input);
+  EXPECT_EQ(registration_.getNumberOfCorrespondences(), 0u);
+  EXPECT_EQ(registration_.getFinalTransformation(), Eigen::Matrix4f::Identity());
+  EXPECT_TRUE(aligned_.empty());
+
+  // pcl::Registration::setInputTarget dereferences its argument, so "no target" is a fresh
+  // instance with only the source and the flow set.
+  dynvo::StaticSceneRegistration<Point> no_target;
+  no_target.setInputSource(pair_.current.cloud);
+  no_target.setInputFlow(pair_.flow);
+  ::testing::internal::CaptureStderr();
+  no_target.align(aligned_);
+  const std::string target_log = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(target_log.find(PREFIX), std::string::npos) << target_log;
+  EXPECT_NE(target_log.find("target"), std::string::npos) << target_log;
+  EXPECT_FALSE(no_target.hasConverged());
+}
+
+TEST_F(StaticSceneRegistrationTest, UnorganizedInputsAreRejected)
+{
+  const auto unorganized = [](auto cloud) {
+    auto copy = pcl::make_shared<typename std::decay_t<decltype(*cloud)>>(*cloud);
+    copy->width = static_cast<std::uint32_t>(copy->size());
+    copy->height = 1;
+    return copy;
+  };
+  registration_.setInputSource(unorganized(pair_.current.cloud));
+  EXPECT_NE(alignCapturingErrors().find(PREFIX), std::string::npos);
+  EXPECT_FALSE(registration_.hasConverged());
+
+  registration_.setInputSource(pair_.current.cloud);
+  registration_.setInputTarget(unorganized(pair_.previous.cloud));
+  EXPECT_NE(alignCapturingErrors().find(PREFIX), std::string::npos);
+  EXPECT_FALSE(registration_.hasConverged());
+
+  registration_.setInputTarget(pair_.previous.cloud);
+  registration_.setInputFlow(unorganized(pair_.flow));
+  EXPECT_NE(alignCapturingErrors().find(PREFIX), std::string::npos);
+  EXPECT_FALSE(registration_.hasConverged());
+}
+
+TEST_F(StaticSceneRegistrationTest, MismatchedSizesAndBadIndicesAreRejected)
+{
+  const BoxScene other = BoxScene::make(96, 64);
+  registration_.setInputTarget(other.render<Point>(false).cloud);
+  EXPECT_NE(alignCapturingErrors().find(PREFIX), std::string::npos);
+  EXPECT_FALSE(registration_.hasConverged());
+
+  // A 10x10 grid cannot tile 160x120 (cell size 16 gives 7 rows).
+  registration_.setInputTarget(pair_.previous.cloud);
+  registration_.setInputFlow(pcl::make_shared<pcl::PointCloud<dynvo::PointFlow>>(10, 10));
+  EXPECT_NE(alignCapturingErrors().find(PREFIX), std::string::npos);
+  EXPECT_FALSE(registration_.hasConverged());
+
+  registration_.setInputFlow(pair_.flow);
+  pcl::PointIndices::Ptr bad(new pcl::PointIndices);
+  bad->indices = {0, static_cast<int>(pair_.current.cloud->size())};
+  registration_.setIndices(bad);
+  EXPECT_NE(alignCapturingErrors().find(PREFIX), std::string::npos);
+  EXPECT_FALSE(registration_.hasConverged());
+  bad->indices = {-1};
+  EXPECT_NE(alignCapturingErrors().find(PREFIX), std::string::npos);
+  EXPECT_FALSE(registration_.hasConverged());
+}
+
+TEST_F(StaticSceneRegistrationTest, CallsThroughThePclBaseAreCheckedToo)
+{
+  pcl::Registration<Point, Point, float>& base = registration_;
+  base.align(aligned_);
+  EXPECT_TRUE(base.hasConverged());
+  registration_.setInputFlow(nullptr);
+  ::testing::internal::CaptureStderr();
+  base.align(aligned_);
+  EXPECT_NE(::testing::internal::GetCapturedStderr().find(PREFIX), std::string::npos);
+  EXPECT_FALSE(base.hasConverged());
+  EXPECT_TRUE(aligned_.empty());
+}
+
+TEST(StaticSceneRegistrationParameters, DefaultsFollowTheAlgorithmAndBadValuesThrow)
+{
+  const dynvo::StaticSceneRegistrationParameters defaults;
+  EXPECT_NO_THROW(defaults.validate());
+  EXPECT_FLOAT_EQ(defaults.th_inlier, 3e-5f);
+  EXPECT_FLOAT_EQ(defaults.trim_factor, 4.0f);
+  EXPECT_EQ(defaults.trim_rounds, 2);
+  EXPECT_EQ(defaults.min_correspondences, 6);
+  EXPECT_EQ(defaults.refinement, dynvo::RegistrationRefinement::none);
+
+  dynvo::StaticSceneRegistration<Point> registration;
+  EXPECT_THROW(registration.setInlierThreshold(0.0f), std::invalid_argument);
+  EXPECT_THROW(registration.setInlierThreshold(std::numeric_limits<float>::quiet_NaN()),
+               std::invalid_argument);
+  EXPECT_THROW(registration.setTrimFactor(0.5f), std::invalid_argument);
+  EXPECT_THROW(registration.setTrimRounds(-1), std::invalid_argument);
+  EXPECT_THROW(registration.setMinCorrespondences(2), std::invalid_argument);
+  EXPECT_THROW(registration.setRefinement(static_cast<dynvo::RegistrationRefinement>(7)),
+               std::invalid_argument);
+  EXPECT_THROW(registration.setRefinementMaxCorrespondenceDistance(0.0), std::invalid_argument);
+  EXPECT_THROW(registration.setRefinementMaxIterations(0), std::invalid_argument);
+  EXPECT_THROW(registration.setRefinementTransformationEpsilon(-1.0), std::invalid_argument);
+  EXPECT_THROW(registration.setRefinementStride(0), std::invalid_argument);
+  // A rejected value leaves the previous one in place.
+  EXPECT_FLOAT_EQ(registration.getInlierThreshold(), 3e-5f);
+  EXPECT_EQ(registration.getRefinementStride(), defaults.refinement_stride);
+  registration.setTrimRounds(3);
+  EXPECT_EQ(registration.getParameters().trim_rounds, 3);
+  try {
+    registration.setTrimFactor(0.5f);
+  }
+  catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("trim_factor"), std::string::npos) << e.what();
+  }
+}
+
+TEST(StaticSceneRegistrationVga, VgaFramesWorkAndAMismatchedGridIsRejected)
+{
+  const BoxScene scene = BoxScene::make(640, 480);
+  const FramePair<pcl::PointXYZRGBA> pair(scene);
+  EXPECT_EQ(pair.flow->width, 40u);
+  EXPECT_EQ(pair.flow->height, 30u);
+  dynvo::StaticSceneRegistration<pcl::PointXYZRGBA> registration;
+  registration.setInputSource(pair.current.cloud);
+  registration.setInputTarget(pair.previous.cloud);
+  registration.setIndices(pair.staticPixels(scene.width));
+  registration.setInputFlow(pair.flow);
+  pcl::PointCloud<pcl::PointXYZRGBA> aligned;
+  registration.align(aligned);
+  ASSERT_TRUE(registration.hasConverged());
+  const Eigen::Matrix4d truth = scene.T_curr_prev.inverse().matrix();
+  EXPECT_LT(rotationErrorDeg(registration.getFinalTransformation(), truth), ROTATION_TOL);
+  EXPECT_LT(translationError(registration.getFinalTransformation(), truth), TRANSLATION_TOL);
+  EXPECT_EQ(registration.getNumberOfCorrespondences(), pair.staticCellCount());
+
+  // 40x40 cells of 16 px would need 640 rows.
+  registration.setInputFlow(pcl::make_shared<pcl::PointCloud<dynvo::PointFlow>>(40, 40));
+  ::testing::internal::CaptureStderr();
+  registration.align(aligned);
+  EXPECT_NE(::testing::internal::GetCapturedStderr().find(PREFIX), std::string::npos);
+  EXPECT_FALSE(registration.hasConverged());
+}
+
+} // namespace

@@ -1,0 +1,75 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Point-type-independent core of GridSceneFlowEstimation (internal; keeps OpenCV private).
+#pragma once
+
+#include <dynvo/common/camera.h>
+#include <dynvo/common/export.h>
+#include <dynvo/common/point_types.h>
+#include <dynvo/scene_flow/grid_scene_flow_parameters.h>
+
+#include <pcl/point_cloud.h>
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace dynvo::detail {
+
+/** \brief Frame store and grid tracker behind GridSceneFlowEstimation<PointT>.
+ *
+ * Holds, per frame slot, the preprocessed depth map and the grey LK pyramid (with derivatives),
+ * so that the template only converts points to grey levels and depths. Not thread-safe.
+ */
+class DYNVO_EXPORTS GridFlowEngine {
+public:
+  /// Which of the two stored frames an operation addresses.
+  enum class Slot { current, previous };
+
+  GridFlowEngine();
+  ~GridFlowEngine();
+  GridFlowEngine(const GridFlowEngine&) = delete;
+  GridFlowEngine&
+  operator=(const GridFlowEngine&) = delete;
+
+  /** \brief Preprocess a frame's depth and build its pyramid into a slot.
+   * \param[in] grey width * height grey levels, row-major
+   * \param[in] depth width * height depths (metres, NaN = none), row-major
+   * \param[in] width columns (px)
+   * \param[in] height rows (px)
+   * \param[in] params validated parameters (depth rules, LK window and levels)
+   * \param[in] threads worker threads (>= 1)
+   */
+  void
+  prepare(Slot slot,
+          const std::vector<std::uint8_t>& grey,
+          const std::vector<float>& depth,
+          std::uint32_t width,
+          std::uint32_t height,
+          const GridSceneFlowParameters& params,
+          unsigned threads);
+
+  /// The current slot becomes the previous one (no copy); the current slot is then stale.
+  void
+  shiftCurrentToPrevious();
+
+  /** \brief Grid scene flow from the previous to the current slot (ALGORITHM.md §1.2).
+   * Both slots must have been prepared with the same size and params.
+   * \param[out] flow organized (width / cell_size) x (height / cell_size) cloud
+   */
+  void
+  compute(const GridSceneFlowParameters& params,
+          const CameraIntrinsics& intrinsics,
+          unsigned threads,
+          pcl::PointCloud<PointFlow>& flow) const;
+
+  /// Preprocessed depth (metres, NaN = invalid) of a prepared slot, row-major.
+  const std::vector<float>&
+  depth(Slot slot) const;
+
+private:
+  struct Frame;
+  std::unique_ptr<Frame> current_;
+  std::unique_ptr<Frame> previous_;
+};
+
+} // namespace dynvo::detail

@@ -1,0 +1,216 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Grid-based scene flow between two organized RGB-D clouds (ALGORITHM.md §1).
+#pragma once
+
+#include <dynvo/common/camera.h>
+#include <dynvo/common/export.h>
+#include <dynvo/common/point_types.h>
+#include <dynvo/scene_flow/grid_flow_engine.h>
+#include <dynvo/scene_flow/grid_scene_flow_parameters.h>
+
+#include <pcl/pcl_base.h>
+#include <pcl/point_cloud.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace dynvo {
+
+/** \brief Grid-based scene flow of Lee, Son & Kim, "Robust Real-time RGB-D Visual Odometry in
+ * Dynamic Environments via Rigid Motion Model", IROS 2019 (arXiv 1907.08388), §III-A.
+ *
+ * The grid is anchored in the current frame k (the input cloud): each cell centre c_i is tracked
+ * by pyramidal Lucas-Kanade into the previous frame k-1 (p_i) and checked by tracking p_i back
+ * (forward-backward check). Depth is preprocessed (DepthPreprocessing), read at c_i and
+ * interpolated at the sub-pixel p_i, and both are back-projected with the camera intrinsics:
+ * b_i (metres, current camera frame) goes to x, y, z, a_i (metres, previous camera frame) to
+ * prev_x, prev_y, prev_z of a PointFlow. For a static point b_i = T_curr_prev * a_i.
+ *
+ * Output: organized (width / cell_size) x (height / cell_size) cloud; cell i = row * cols + col.
+ * u, v always hold c_i. valid_2d cells hold p_i in prev_u, prev_v (NaN otherwise); x, y, z hold b_i
+ * whenever depth exists at c_i; valid_3d cells also hold a_i and a weight in (0, 1]. Every other
+ * field is NaN and the weight 0. setIndices() is not used: every cell is computed.
+ *
+ * Sequences: after compute(), shiftCurrentToPrevious() turns the current frame (its grey pyramid
+ * and preprocessed depth) into the previous one, so each frame is prepared once.
+ * \code
+ * dynvo::GridSceneFlowEstimation<pcl::PointXYZRGB> flow_estimation;
+ * flow_estimation.setCameraIntrinsics(dynvo::CameraIntrinsics::fromPreset("fr1"));
+ * pcl::PointCloud<dynvo::PointFlow> flow;
+ * flow_estimation.setInputCloud(frames[0]);
+ * for (std::size_t k = 1; k < frames.size(); ++k) {
+ *   flow_estimation.shiftCurrentToPrevious();   // frame k-1 becomes the previous frame
+ *   flow_estimation.setInputCloud(frames[k]);
+ *   flow_estimation.compute(flow);              // flow from frame k-1 to frame k
+ * }
+ * \endcode
+ * Not thread-safe; separate instances may run concurrently. Explicitly instantiated for
+ * pcl::PointXYZRGB and pcl::PointXYZRGBA (other types: include the impl .hpp).
+ */
+template <typename PointT>
+class GridSceneFlowEstimation : public pcl::PCLBase<PointT> {
+public:
+  using Base = pcl::PCLBase<PointT>;
+  using PointCloud = pcl::PointCloud<PointT>;
+  using PointCloudPtr = typename PointCloud::Ptr;
+  using PointCloudConstPtr = typename PointCloud::ConstPtr;
+  using Ptr = pcl::shared_ptr<GridSceneFlowEstimation<PointT>>;
+  using ConstPtr = pcl::shared_ptr<const GridSceneFlowEstimation<PointT>>;
+  using FlowCloud = pcl::PointCloud<PointFlow>;
+  using Parameters = GridSceneFlowParameters;
+
+  GridSceneFlowEstimation() = default;
+
+  /// Name used in log prefixes: "GridSceneFlowEstimation".
+  const std::string&
+  getClassName() const
+  {
+    return class_name_;
+  }
+
+  /// Current frame k (organized, metres, current camera frame); the grid is anchored here.
+  void
+  setInputCloud(const PointCloudConstPtr& cloud) override;
+
+  /// Previous frame k-1 (organized, same size as the input cloud).
+  void
+  setPreviousCloud(const PointCloudConstPtr& cloud);
+
+  const PointCloudConstPtr&
+  getPreviousCloud() const
+  {
+    return previous_;
+  }
+
+  /** \brief Makes the current frame the previous one, keeping its pyramid and depth map.
+   * The input cloud is cleared: set the next frame before calling compute() again.
+   */
+  void
+  shiftCurrentToPrevious();
+
+  /** \brief Computes the grid scene flow from the previous cloud to the input cloud.
+   * \param[out] flow organized grid (see the class doc); empty when the inputs break the
+   *             contract (null, unorganized, sizes differ, smaller than one cell), which is
+   *             logged with PCL_ERROR
+   */
+  void
+  compute(FlowCloud& flow);
+
+  /// \throws std::invalid_argument when intrinsics.validate() fails
+  void
+  setCameraIntrinsics(const CameraIntrinsics& intrinsics);
+
+  const CameraIntrinsics&
+  getCameraIntrinsics() const
+  {
+    return intrinsics_;
+  }
+
+  /// Worker threads (default 1); results are identical for any count. \throws std::invalid_argument on 0
+  void
+  setNumberOfThreads(unsigned threads);
+
+  unsigned
+  getNumberOfThreads() const
+  {
+    return threads_;
+  }
+
+  /// All knobs at once. \throws std::invalid_argument when parameters.validate() fails
+  void
+  setParameters(const Parameters& parameters);
+
+  const Parameters&
+  getParameters() const
+  {
+    return params_;
+  }
+
+  // One setter/getter pair per field of Parameters; each throws std::invalid_argument on a
+  // value out of the range documented in GridSceneFlowParameters.
+  void setCellSize(int px) { updateField(&Parameters::cell_size, px); }
+  int getCellSize() const { return params_.cell_size; }
+  void setMinDepth(float metres) { updateDepthField(&DepthPreprocessing::Parameters::min_depth, metres); }
+  float getMinDepth() const { return params_.depth.min_depth; }
+  void setMaxDepth(float metres) { updateDepthField(&DepthPreprocessing::Parameters::max_depth, metres); }
+  float getMaxDepth() const { return params_.depth.max_depth; }
+  void setFlyingPixelTolerance(float ratio) { updateDepthField(&DepthPreprocessing::Parameters::flying_pixel_tolerance, ratio); }
+  float getFlyingPixelTolerance() const { return params_.depth.flying_pixel_tolerance; }
+  void setMaxHoleWidth(int px) { updateDepthField(&DepthPreprocessing::Parameters::max_hole_width, px); }
+  int getMaxHoleWidth() const { return params_.depth.max_hole_width; }
+  void setHoleFillTolerance(float ratio) { updateDepthField(&DepthPreprocessing::Parameters::hole_fill_tolerance, ratio); }
+  float getHoleFillTolerance() const { return params_.depth.hole_fill_tolerance; }
+  void setWindowSize(int px) { updateField(&Parameters::window_size, px); }
+  int getWindowSize() const { return params_.window_size; }
+  void setMaxPyramidLevel(int level) { updateField(&Parameters::max_pyramid_level, level); }
+  int getMaxPyramidLevel() const { return params_.max_pyramid_level; }
+  void setMaxIterations(int iterations) { updateField(&Parameters::max_iterations, iterations); }
+  int getMaxIterations() const { return params_.max_iterations; }
+  void setEpsilon(double px) { updateField(&Parameters::epsilon, px); }
+  double getEpsilon() const { return params_.epsilon; }
+  void setMinEigenThreshold(double threshold) { updateField(&Parameters::min_eigen_threshold, threshold); }
+  double getMinEigenThreshold() const { return params_.min_eigen_threshold; }
+  void setForwardBackwardCheck(ForwardBackwardCheck check) { updateField(&Parameters::forward_backward_check, check); }
+  ForwardBackwardCheck getForwardBackwardCheck() const { return params_.forward_backward_check; }
+  void setForwardBackwardThreshold(float px) { updateField(&Parameters::forward_backward_threshold, px); }
+  float getForwardBackwardThreshold() const { return params_.forward_backward_threshold; }
+  void setDepthEdgeTolerance(float ratio) { updateField(&Parameters::depth_edge_tolerance, ratio); }
+  float getDepthEdgeTolerance() const { return params_.depth_edge_tolerance; }
+  void setMaxFlow(float metres) { updateField(&Parameters::max_flow, metres); }
+  float getMaxFlow() const { return params_.max_flow; }
+  void setWeightReferenceDepth(float metres) { updateField(&Parameters::weight_reference_depth, metres); }
+  float getWeightReferenceDepth() const { return params_.weight_reference_depth; }
+
+protected:
+  using Base::deinitCompute;
+  using Base::input_;
+
+  /// Non-null, organized inputs of equal size; logs PCL_ERROR and returns false otherwise.
+  bool
+  initCompute();
+
+  /// The image holds at least one grid cell; logs PCL_ERROR and returns false otherwise.
+  bool
+  validateInputs() const;
+
+  /// Converts a cloud to grey levels and depths and prepares it in an engine slot.
+  void
+  prepareFrame(const PointCloud& cloud, detail::GridFlowEngine::Slot slot);
+
+private:
+  template <typename Field>
+  void
+  updateField(Field Parameters::*field, Field value)
+  {
+    Parameters updated = params_;
+    updated.*field = value;
+    setParameters(updated);
+  }
+
+  template <typename Field>
+  void
+  updateDepthField(Field DepthPreprocessing::Parameters::*field, Field value)
+  {
+    Parameters updated = params_;
+    updated.depth.*field = value;
+    setParameters(updated);
+  }
+
+  std::string class_name_ = "GridSceneFlowEstimation"; ///< log prefix
+  Parameters params_;                ///< validated knobs
+  CameraIntrinsics intrinsics_;      ///< back-projection (default preset "default")
+  unsigned threads_ = 1;             ///< worker threads
+  PointCloudConstPtr previous_;      ///< frame k-1
+  detail::GridFlowEngine engine_;    ///< pyramids and preprocessed depth of both frames
+  bool current_ready_ = false;       ///< engine current slot matches input_ and params_
+  bool previous_ready_ = false;      ///< engine previous slot matches previous_ and params_
+  std::vector<std::uint8_t> grey_;   ///< conversion buffer (grey levels)
+  std::vector<float> depth_;         ///< conversion buffer (metres)
+};
+
+} // namespace dynvo
+
+#ifdef DYNVO_NO_PRECOMPILE
+#include <dynvo/scene_flow/impl/grid_scene_flow_estimation.hpp>
+#endif

@@ -1,0 +1,149 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Template bodies of GridSceneFlowEstimation (compiled in src/ for XYZRGB and XYZRGBA).
+#pragma once
+
+#include <dynvo/scene_flow/grid_scene_flow_estimation.h>
+
+#include <pcl/console/print.h>
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace dynvo {
+
+template <typename PointT>
+void
+GridSceneFlowEstimation<PointT>::setInputCloud(const PointCloudConstPtr& cloud)
+{
+  Base::setInputCloud(cloud);
+  current_ready_ = false;
+}
+
+template <typename PointT>
+void
+GridSceneFlowEstimation<PointT>::setPreviousCloud(const PointCloudConstPtr& cloud)
+{
+  previous_ = cloud;
+  previous_ready_ = false;
+}
+
+template <typename PointT>
+void
+GridSceneFlowEstimation<PointT>::shiftCurrentToPrevious()
+{
+  engine_.shiftCurrentToPrevious();
+  previous_ = input_;
+  previous_ready_ = current_ready_;
+  input_.reset();
+  current_ready_ = false;
+}
+
+template <typename PointT>
+void
+GridSceneFlowEstimation<PointT>::setCameraIntrinsics(const CameraIntrinsics& intrinsics)
+{
+  intrinsics.validate();
+  intrinsics_ = intrinsics;
+}
+
+template <typename PointT>
+void
+GridSceneFlowEstimation<PointT>::setNumberOfThreads(unsigned threads)
+{
+  if (threads == 0)
+    throw std::invalid_argument("[dynvo::" + getClassName() +
+                                "::setNumberOfThreads] need at least 1 thread, got 0");
+  threads_ = threads;
+}
+
+template <typename PointT>
+void
+GridSceneFlowEstimation<PointT>::setParameters(const Parameters& parameters)
+{
+  parameters.validate();
+  params_ = parameters;
+  // Pyramids depend on the LK window and levels, depth maps on the depth rules.
+  current_ready_ = false;
+  previous_ready_ = false;
+}
+
+template <typename PointT>
+bool
+GridSceneFlowEstimation<PointT>::initCompute()
+{
+  const char* name = getClassName().c_str();
+  if (!input_ || !previous_) {
+    PCL_ERROR("[dynvo::%s::compute] %s cloud not set.\n", name,
+              input_ ? "previous" : "input (current)");
+    return false;
+  }
+  if (!input_->isOrganized() || !previous_->isOrganized()) {
+    PCL_ERROR("[dynvo::%s::compute] %s cloud is not organized.\n", name,
+              input_->isOrganized() ? "previous" : "input (current)");
+    return false;
+  }
+  if (input_->width != previous_->width || input_->height != previous_->height) {
+    PCL_ERROR("[dynvo::%s::compute] input cloud is %ux%u but previous cloud is %ux%u.\n",
+              name, input_->width, input_->height, previous_->width, previous_->height);
+    return false;
+  }
+  return true;
+}
+
+template <typename PointT>
+bool
+GridSceneFlowEstimation<PointT>::validateInputs() const
+{
+  const auto cell = static_cast<std::uint32_t>(params_.cell_size);
+  if (input_->width < cell || input_->height < cell) {
+    PCL_ERROR("[dynvo::%s::compute] a %ux%u cloud holds no %u px grid cell.\n",
+              getClassName().c_str(), input_->width, input_->height, cell);
+    return false;
+  }
+  return true;
+}
+
+template <typename PointT>
+void
+GridSceneFlowEstimation<PointT>::prepareFrame(const PointCloud& cloud,
+                                              detail::GridFlowEngine::Slot slot)
+{
+  const std::size_t size = cloud.size();
+  grey_.resize(size);
+  depth_.resize(size);
+  for (std::size_t i = 0; i < size; ++i) {
+    const PointT& p = cloud[i];
+    // ITU-R BT.601 luma in 14-bit fixed point, the weights of cv::cvtColor(RGB2GRAY).
+    grey_[i] = static_cast<std::uint8_t>((4899u * p.r + 9617u * p.g + 1868u * p.b + 8192u) >>
+                                         14);
+    depth_[i] = std::isfinite(p.z) ? p.z : std::numeric_limits<float>::quiet_NaN();
+  }
+  engine_.prepare(slot, grey_, depth_, cloud.width, cloud.height, params_, threads_);
+}
+
+template <typename PointT>
+void
+GridSceneFlowEstimation<PointT>::compute(FlowCloud& flow)
+{
+  flow.clear();
+  if (!initCompute())
+    return;
+  struct DeinitGuard {
+    GridSceneFlowEstimation& self;
+    ~DeinitGuard() { self.deinitCompute(); }
+  } guard{*this};
+  if (!validateInputs())
+    return;
+  if (!current_ready_)
+    prepareFrame(*input_, detail::GridFlowEngine::Slot::current);
+  current_ready_ = true;
+  if (!previous_ready_)
+    prepareFrame(*previous_, detail::GridFlowEngine::Slot::previous);
+  previous_ready_ = true;
+  engine_.compute(params_, intrinsics_, threads_, flow);
+  flow.header = input_->header;
+}
+
+} // namespace dynvo

@@ -1,0 +1,192 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <dynvo/scene_flow/depth_preprocessing.h>
+
+#include "parallel_stripes.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace dynvo {
+
+namespace {
+
+constexpr float NaN = std::numeric_limits<float>::quiet_NaN();
+/// ALGORITHM.md §1.1: the 3x3 median is trusted only with at least 5 valid neighbours.
+constexpr int MIN_FLYING_NEIGHBOURS = 5;
+
+/// Fills the gap between valid samples l and r (exclusive) of a line with stride `step`.
+void
+fillGap(float* line, std::size_t l, std::size_t r, std::size_t step)
+{
+  const float zl = line[l * step];
+  const float zr = line[r * step];
+  const float span = static_cast<float>(r - l);
+  for (std::size_t k = l + 1; k < r; ++k)
+    line[k * step] = zl + (zr - zl) * static_cast<float>(k - l) / span;
+}
+
+bool
+similar(float zl, float zr, float tolerance)
+{
+  return std::abs(zl - zr) <= tolerance * std::min(zl, zr);
+}
+
+} // namespace
+
+void
+DepthPreprocessing::Parameters::validate() const
+{
+  const auto fail = [](const std::string& what) {
+    throw std::invalid_argument("[dynvo::DepthPreprocessing::Parameters::validate] " + what);
+  };
+  if (!(std::isfinite(min_depth) && std::isfinite(max_depth) && min_depth > 0.0f &&
+        max_depth > min_depth))
+    fail("need 0 < min_depth < max_depth (metres), got min_depth=" +
+         std::to_string(min_depth) + " max_depth=" + std::to_string(max_depth));
+  if (!(flying_pixel_tolerance > 0.0f && flying_pixel_tolerance < 1.0f))
+    fail("flying_pixel_tolerance must be in (0, 1), got " +
+         std::to_string(flying_pixel_tolerance));
+  if (max_hole_width < 0)
+    fail("max_hole_width must be >= 0 px, got " + std::to_string(max_hole_width));
+  if (!(hole_fill_tolerance >= 0.0f && std::isfinite(hole_fill_tolerance)))
+    fail("hole_fill_tolerance must be finite and >= 0, got " +
+         std::to_string(hole_fill_tolerance));
+}
+
+DepthPreprocessing::DepthPreprocessing(const Parameters& parameters)
+{
+  setParameters(parameters);
+}
+
+void
+DepthPreprocessing::setParameters(const Parameters& parameters)
+{
+  parameters.validate();
+  params_ = parameters;
+}
+
+void
+DepthPreprocessing::setNumberOfThreads(unsigned threads)
+{
+  if (threads == 0)
+    throw std::invalid_argument(
+        "[dynvo::DepthPreprocessing::setNumberOfThreads] need at least 1 thread, got 0");
+  threads_ = threads;
+}
+
+void
+DepthPreprocessing::apply(const std::vector<float>& depth,
+                          std::uint32_t width,
+                          std::uint32_t height,
+                          std::vector<float>& out) const
+{
+  const std::size_t w = width;
+  const std::size_t h = height;
+  if (depth.size() != w * h)
+    throw std::invalid_argument("[dynvo::DepthPreprocessing::apply] depth holds " +
+                                std::to_string(depth.size()) + " values, expected " +
+                                std::to_string(width) + "x" + std::to_string(height));
+  if (&depth == &out)
+    throw std::invalid_argument("[dynvo::DepthPreprocessing::apply] out aliases depth");
+  out.resize(w * h);
+
+  // Steps 1 and 2 read only the input, so rows are independent. A neighbour q counts when it
+  // passes the range test; "median < lo" and "median > hi" are decided by counting, which avoids
+  // sorting (see the class doc for the median definition):
+  //   |z - m| > tau m  <=>  m < z / (1 + tau)  or  m > z / (1 - tau)   (m > 0, tau < 1).
+  const float z_min = params_.min_depth;
+  const float z_max = params_.max_depth;
+  const float tau_fly = params_.flying_pixel_tolerance;
+  const auto in_range = [z_min, z_max](float q) { return (q >= z_min) & (q <= z_max); };
+  // Depth kept at pixel (x, y) given its neighbours n[0..count) (branch-free for vectorising).
+  const auto keep = [&](float z, const float* n, int count) {
+    const float lo = z / (1.0f + tau_fly);
+    const float hi = z / (1.0f - tau_fly);
+    int valid = 0, below = 0, above = 0;
+    for (int j = 0; j < count; ++j) {
+      const int ok = in_range(n[j]);
+      valid += ok;
+      below += ok & (n[j] < lo);
+      above += ok & (n[j] > hi);
+    }
+    const int k = valid / 2; // index of the median in the sorted valid neighbours
+    const bool flying =
+        (valid >= MIN_FLYING_NEIGHBOURS) & ((below >= k + 1) | (above >= valid - k));
+    return in_range(z) && !flying ? z : NaN;
+  };
+  // Border pixels: gather the neighbours that exist.
+  const auto border_pixel = [&](std::size_t x, std::size_t y) {
+    float n[8];
+    int count = 0;
+    for (std::size_t yy = y > 0 ? y - 1 : y; yy <= std::min(y + 1, h - 1); ++yy)
+      for (std::size_t xx = x > 0 ? x - 1 : x; xx <= std::min(x + 1, w - 1); ++xx)
+        if (yy != y || xx != x)
+          n[count++] = depth[yy * w + xx];
+    out[y * w + x] = keep(depth[y * w + x], n, count);
+  };
+  detail::runStripes(threads_, [&](unsigned s) {
+    const auto [row_begin, row_end] = detail::stripeRange(h, threads_, s);
+    for (std::size_t y = row_begin; y < row_end; ++y) {
+      if (y == 0 || y + 1 == h || w < 3) {
+        for (std::size_t x = 0; x < w; ++x)
+          border_pixel(x, y);
+        continue;
+      }
+      border_pixel(0, y);
+      const float* up = depth.data() + (y - 1) * w;
+      const float* mid = up + w;
+      const float* down = mid + w;
+      float* dst = out.data() + y * w;
+      for (std::size_t x = 1; x + 1 < w; ++x) {
+        const float n[8] = {up[x - 1],  up[x],       up[x + 1],   mid[x - 1],
+                            mid[x + 1], down[x - 1], down[x],     down[x + 1]};
+        dst[x] = keep(mid[x], n, 8);
+      }
+      border_pixel(w - 1, y);
+    }
+  });
+
+  const std::size_t max_gap = static_cast<std::size_t>(params_.max_hole_width);
+  if (max_gap == 0)
+    return;
+  const float tau_fill = params_.hole_fill_tolerance;
+  // Row pass: each row is its own line.
+  detail::runStripes(threads_, [&](unsigned s) {
+    const auto [row_begin, row_end] = detail::stripeRange(h, threads_, s);
+    for (std::size_t y = row_begin; y < row_end; ++y) {
+      float* line = out.data() + y * w;
+      std::size_t last = w; // no valid pixel seen yet
+      for (std::size_t x = 0; x < w; ++x) {
+        if (std::isnan(line[x]))
+          continue;
+        if (last != w && x - last - 1 >= 1 && x - last - 1 <= max_gap &&
+            similar(line[last], line[x], tau_fill))
+          fillGap(line, last, x, 1);
+        last = x;
+      }
+    }
+  });
+  // Column pass on the row-filled map: stripes own column ranges and walk the rows in order,
+  // remembering the last valid row of every column, which keeps memory access row-major.
+  detail::runStripes(threads_, [&](unsigned s) {
+    const auto [col_begin, col_end] = detail::stripeRange(w, threads_, s);
+    std::vector<std::size_t> last(col_end - col_begin, h);
+    for (std::size_t y = 0; y < h; ++y) {
+      for (std::size_t x = col_begin; x < col_end; ++x) {
+        const float z = out[y * w + x];
+        if (std::isnan(z))
+          continue;
+        std::size_t& l = last[x - col_begin];
+        if (l != h && y - l - 1 >= 1 && y - l - 1 <= max_gap &&
+            similar(out[l * w + x], z, tau_fill))
+          fillGap(out.data() + x, l, y, w);
+        l = y;
+      }
+    }
+  });
+}
+
+} // namespace dynvo

@@ -1,0 +1,269 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <dynvo/scene_flow/grid_flow_engine.h>
+
+#include "parallel_stripes.h"
+
+#include <opencv2/core.hpp>
+#include <opencv2/video/tracking.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace dynvo {
+
+void
+GridSceneFlowParameters::validate() const
+{
+  const auto fail = [](const std::string& what) {
+    throw std::invalid_argument("[dynvo::GridSceneFlowParameters::validate] " + what);
+  };
+  if (cell_size < 2)
+    fail("cell_size must be >= 2 px, got " + std::to_string(cell_size));
+  depth.validate();
+  if (window_size < 3)
+    fail("window_size must be >= 3 px, got " + std::to_string(window_size));
+  if (max_pyramid_level < 0)
+    fail("max_pyramid_level must be >= 0, got " + std::to_string(max_pyramid_level));
+  if (max_iterations < 1)
+    fail("max_iterations must be >= 1, got " + std::to_string(max_iterations));
+  if (!(epsilon > 0.0 && std::isfinite(epsilon)))
+    fail("epsilon must be > 0 px, got " + std::to_string(epsilon));
+  if (!(min_eigen_threshold > 0.0 && std::isfinite(min_eigen_threshold)))
+    fail("min_eigen_threshold must be > 0, got " + std::to_string(min_eigen_threshold));
+  if (forward_backward_check != ForwardBackwardCheck::full &&
+      forward_backward_check != ForwardBackwardCheck::local)
+    fail("forward_backward_check must be full or local, got " +
+         std::to_string(static_cast<int>(forward_backward_check)));
+  if (!(forward_backward_threshold > 0.0f && std::isfinite(forward_backward_threshold)))
+    fail("forward_backward_threshold must be > 0 px, got " +
+         std::to_string(forward_backward_threshold));
+  if (!(depth_edge_tolerance >= 0.0f && std::isfinite(depth_edge_tolerance)))
+    fail("depth_edge_tolerance must be finite and >= 0, got " +
+         std::to_string(depth_edge_tolerance));
+  if (!(max_flow > 0.0f && std::isfinite(max_flow)))
+    fail("max_flow must be > 0 m, got " + std::to_string(max_flow));
+  if (!(weight_reference_depth > 0.0f && std::isfinite(weight_reference_depth)))
+    fail("weight_reference_depth must be > 0 m, got " +
+         std::to_string(weight_reference_depth));
+}
+
+namespace detail {
+
+namespace {
+
+constexpr float NaN = std::numeric_limits<float>::quiet_NaN();
+/// ALGORITHM.md §1.2: the 3x3 median replacing a missing centre depth needs 3 valid neighbours.
+constexpr int MIN_CENTRE_NEIGHBOURS = 3;
+
+/// Depth b_i at the integer cell centre, or NaN (ALGORITHM.md §1.2).
+float
+centreDepth(const std::vector<float>& depth, int width, int height, int u, int v)
+{
+  const float z = depth[static_cast<std::size_t>(v) * width + u];
+  if (!std::isnan(z))
+    return z;
+  std::array<float, 8> values;
+  int n = 0;
+  for (int y = std::max(v - 1, 0); y <= std::min(v + 1, height - 1); ++y)
+    for (int x = std::max(u - 1, 0); x <= std::min(u + 1, width - 1); ++x) {
+      const float q = depth[static_cast<std::size_t>(y) * width + x];
+      if (!std::isnan(q))
+        values[n++] = q;
+    }
+  if (n < MIN_CENTRE_NEIGHBOURS)
+    return NaN;
+  // Upper middle element, the median definition DepthPreprocessing uses as well.
+  std::nth_element(values.begin(), values.begin() + n / 2, values.begin() + n);
+  return values[n / 2];
+}
+
+/// Depth a_i at a sub-pixel position inside [0, width-2] x [0, height-2] (ALGORITHM.md §1.2).
+float
+trackedDepth(const std::vector<float>& depth, int width, cv::Point2f p, float tau_edge)
+{
+  const int x0 = static_cast<int>(std::floor(p.x));
+  const int y0 = static_cast<int>(std::floor(p.y));
+  const float fx = p.x - static_cast<float>(x0);
+  const float fy = p.y - static_cast<float>(y0);
+  const float* row0 = depth.data() + static_cast<std::size_t>(y0) * width + x0;
+  const float* row1 = row0 + width;
+  const float z00 = row0[0], z10 = row0[1], z01 = row1[0], z11 = row1[1];
+  const bool all_valid =
+      !(std::isnan(z00) || std::isnan(z10) || std::isnan(z01) || std::isnan(z11));
+  if (all_valid) {
+    const float lo = std::min(std::min(z00, z10), std::min(z01, z11));
+    const float hi = std::max(std::max(z00, z10), std::max(z01, z11));
+    if (hi - lo <= tau_edge * lo)
+      return (1.0f - fy) * ((1.0f - fx) * z00 + fx * z10) + fy * ((1.0f - fx) * z01 + fx * z11);
+  }
+  // Nearest of the four pixels: it may be valid even when the window straddles an edge.
+  const float* row = fy < 0.5f ? row0 : row1;
+  return row[fx < 0.5f ? 0 : 1];
+}
+
+} // namespace
+
+struct GridFlowEngine::Frame {
+  std::uint32_t width = 0;
+  std::uint32_t height = 0;
+  std::vector<cv::Mat> pyramid; ///< cv::buildOpticalFlowPyramid output, with derivatives
+  std::vector<float> depth;     ///< preprocessed (metres, NaN = invalid)
+  DepthPreprocessing preprocessing;
+};
+
+GridFlowEngine::GridFlowEngine()
+: current_(std::make_unique<Frame>()), previous_(std::make_unique<Frame>())
+{}
+
+GridFlowEngine::~GridFlowEngine() = default;
+
+void
+GridFlowEngine::prepare(Slot slot,
+                        const std::vector<std::uint8_t>& grey,
+                        const std::vector<float>& depth,
+                        std::uint32_t width,
+                        std::uint32_t height,
+                        const GridSceneFlowParameters& params,
+                        unsigned threads)
+{
+  Frame& frame = slot == Slot::current ? *current_ : *previous_;
+  frame.width = width;
+  frame.height = height;
+  frame.preprocessing.setParameters(params.depth);
+  frame.preprocessing.setNumberOfThreads(threads);
+  frame.preprocessing.apply(depth, width, height, frame.depth);
+  // The grey buffer is only read: buildOpticalFlowPyramid copies level 0 into a padded image.
+  const cv::Mat image(static_cast<int>(height), static_cast<int>(width), CV_8UC1,
+                      const_cast<std::uint8_t*>(grey.data()));
+  runStripes(1, [&](unsigned) {
+    cv::buildOpticalFlowPyramid(image, frame.pyramid,
+                                cv::Size(params.window_size, params.window_size),
+                                params.max_pyramid_level, true);
+  });
+}
+
+void
+GridFlowEngine::shiftCurrentToPrevious()
+{
+  std::swap(current_, previous_);
+}
+
+const std::vector<float>&
+GridFlowEngine::depth(Slot slot) const
+{
+  return slot == Slot::current ? current_->depth : previous_->depth;
+}
+
+void
+GridFlowEngine::compute(const GridSceneFlowParameters& params,
+                        const CameraIntrinsics& intrinsics,
+                        unsigned threads,
+                        pcl::PointCloud<PointFlow>& flow) const
+{
+  const Frame& curr = *current_;
+  const Frame& prev = *previous_;
+  const int width = static_cast<int>(curr.width);
+  const int height = static_cast<int>(curr.height);
+  const int cell = params.cell_size;
+  const int cols = width / cell;
+  const int rows = height / cell;
+  const std::size_t n = static_cast<std::size_t>(cols) * rows;
+
+  std::vector<cv::Point2f> centres(n);
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c)
+      centres[static_cast<std::size_t>(r) * cols + c] =
+          cv::Point2f(static_cast<float>(c * cell + cell / 2),
+                      static_cast<float>(r * cell + cell / 2));
+
+  // Track every centre c_i from I^k into I^{k-1} (p_i), then p_i back into I^k (c'_i).
+  std::vector<cv::Point2f> tracked(n);
+  std::vector<std::uint8_t> valid2d(n, 0);
+  const cv::Size window(params.window_size, params.window_size);
+  const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
+                                  params.max_iterations, params.epsilon);
+  const float fb2 = params.forward_backward_threshold * params.forward_backward_threshold;
+  const unsigned stripes = static_cast<unsigned>(std::min<std::size_t>(threads, n));
+  runStripes(stripes, [&](unsigned s) {
+    const auto [begin, end] = stripeRange(n, stripes, s);
+    const std::vector<cv::Point2f> from(centres.begin() + begin, centres.begin() + end);
+    std::vector<cv::Point2f> to;
+    std::vector<std::uint8_t> status;
+    cv::calcOpticalFlowPyrLK(curr.pyramid, prev.pyramid, from, to, status, cv::noArray(),
+                             window, params.max_pyramid_level, criteria, 0,
+                             params.min_eigen_threshold);
+    std::vector<cv::Point2f> forward;
+    std::vector<std::size_t> index;
+    for (std::size_t k = 0; k < from.size(); ++k) {
+      tracked[begin + k] = to[k];
+      const cv::Point2f& p = to[k];
+      // p_i inside [1, W-2] x [1, H-2]: the 2x2 bilinear depth footprint stays in the image.
+      if (status[k] && p.x >= 1.0f && p.y >= 1.0f && p.x <= width - 2.0f &&
+          p.y <= height - 2.0f) {
+        forward.push_back(p);
+        index.push_back(begin + k);
+      }
+    }
+    if (forward.empty())
+      return;
+    std::vector<cv::Point2f> back;
+    if (params.forward_backward_check == ForwardBackwardCheck::full) {
+      cv::calcOpticalFlowPyrLK(prev.pyramid, curr.pyramid, forward, back, status,
+                               cv::noArray(), window, params.max_pyramid_level, criteria, 0,
+                               params.min_eigen_threshold);
+    }
+    else {
+      for (const std::size_t i : index)
+        back.push_back(centres[i]);
+      cv::calcOpticalFlowPyrLK(prev.pyramid, curr.pyramid, forward, back, status,
+                               cv::noArray(), window, 0, criteria,
+                               cv::OPTFLOW_USE_INITIAL_FLOW, params.min_eigen_threshold);
+    }
+    for (std::size_t k = 0; k < forward.size(); ++k) {
+      const cv::Point2f d = back[k] - centres[index[k]];
+      valid2d[index[k]] = status[k] && d.dot(d) <= fb2;
+    }
+  });
+
+  flow.resize(static_cast<std::uint32_t>(cols), static_cast<std::uint32_t>(rows));
+  flow.is_dense = false;
+  const float max_flow2 = params.max_flow * params.max_flow;
+  for (std::size_t i = 0; i < n; ++i) {
+    PointFlow& f = flow[i];
+    const cv::Point2f c = centres[i];
+    const cv::Point2f p = tracked[i];
+    f.u = c.x;
+    f.v = c.y;
+    f.valid_2d = valid2d[i];
+    f.prev_u = f.valid_2d ? p.x : NaN;
+    f.prev_v = f.valid_2d ? p.y : NaN;
+    const float z_b = centreDepth(curr.depth, width, height, static_cast<int>(c.x),
+                                  static_cast<int>(c.y));
+    f.getVector3fMap() = std::isnan(z_b) ? Eigen::Vector3f::Constant(NaN)
+                                         : intrinsics.backproject(c.x, c.y, z_b);
+    f.prev_x = f.prev_y = f.prev_z = NaN;
+    f.weight = 0.0f;
+    f.valid_3d = 0;
+    if (!f.valid_2d || std::isnan(z_b))
+      continue;
+    const float z_a = trackedDepth(prev.depth, width, p, params.depth_edge_tolerance);
+    if (std::isnan(z_a))
+      continue;
+    const Eigen::Vector3f a = intrinsics.backproject(p.x, p.y, z_a);
+    if ((f.getVector3fMap() - a).squaredNorm() > max_flow2)
+      continue;
+    f.prev_x = a.x();
+    f.prev_y = a.y();
+    f.prev_z = a.z();
+    f.valid_3d = 1;
+    const float ratio = params.weight_reference_depth / std::max(z_a, z_b);
+    f.weight = std::min(1.0f, ratio * ratio * ratio * ratio);
+  }
+}
+
+} // namespace detail
+} // namespace dynvo

@@ -1,0 +1,402 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <dynvo/scene_flow/grid_scene_flow_estimation.h>
+
+#include "textured_scene.h"
+
+#include <pcl/point_types.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+namespace {
+
+using dynvo::CameraIntrinsics;
+using dynvo::PointFlow;
+using dynvo::test::TexturedQuad;
+using FlowCloud = pcl::PointCloud<PointFlow>;
+
+constexpr double PI = 3.14159265358979323846;
+
+/// The "default" preset scaled from 640x480 to the test image size.
+CameraIntrinsics
+scaledIntrinsics(std::uint32_t width)
+{
+  const double s = width / 640.0;
+  return {525.0 * s, 525.0 * s, (319.5 + 0.5) * s - 0.5, (239.5 + 0.5) * s - 0.5};
+}
+
+Eigen::Isometry3d
+pose(double rx_deg, double ry_deg, double rz_deg, double tx, double ty, double tz)
+{
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = (Eigen::AngleAxisd(rz_deg * PI / 180.0, Eigen::Vector3d::UnitZ()) *
+                Eigen::AngleAxisd(ry_deg * PI / 180.0, Eigen::Vector3d::UnitY()) *
+                Eigen::AngleAxisd(rx_deg * PI / 180.0, Eigen::Vector3d::UnitX()))
+                   .toRotationMatrix();
+  T.translation() = Eigen::Vector3d(tx, ty, tz);
+  return T;
+}
+
+/// A static room seen from about 1.2-2 m: a back wall and a slanted board in front of it.
+std::vector<TexturedQuad>
+staticRoom()
+{
+  TexturedQuad wall;
+  wall.T_world_quad = pose(0, 0, 0, 0, 0, 2.0);
+  wall.half_width = 3.0;
+  wall.half_height = 2.5;
+  wall.seed = 1;
+  TexturedQuad board;
+  board.T_world_quad = pose(10, -25, 0, -0.35, 0.1, 1.4);
+  board.half_width = 0.35;
+  board.half_height = 0.3;
+  board.seed = 2;
+  board.id = 1;
+  return {wall, board};
+}
+
+double
+median(std::vector<double> values)
+{
+  const auto mid = values.begin() + values.size() / 2;
+  std::nth_element(values.begin(), mid, values.end());
+  return *mid;
+}
+
+Eigen::Vector3d
+prevPoint(const PointFlow& f)
+{
+  return Eigen::Vector3d(f.prev_x, f.prev_y, f.prev_z);
+}
+
+Eigen::Vector3d
+currPoint(const PointFlow& f)
+{
+  return f.getVector3fMap().cast<double>();
+}
+
+/// Output invariants of the class doc, checked on every cell.
+void
+expectCellContract(const FlowCloud& flow)
+{
+  for (const PointFlow& f : flow) {
+    if (f.valid_3d) {
+      EXPECT_TRUE(f.valid_2d);
+      EXPECT_TRUE(std::isfinite(f.prev_z) && std::isfinite(f.z));
+      EXPECT_GT(f.weight, 0.0f);
+      EXPECT_LE(f.weight, 1.0f);
+    } else {
+      EXPECT_EQ(f.weight, 0.0f);
+      EXPECT_TRUE(std::isnan(f.prev_x) && std::isnan(f.prev_y) && std::isnan(f.prev_z));
+    }
+    if (!f.valid_2d)
+      EXPECT_TRUE(std::isnan(f.prev_u) && std::isnan(f.prev_v));
+  }
+}
+
+/// Byte-wise equality (NaN fields compare equal when their bits do).
+bool
+identical(const FlowCloud& a, const FlowCloud& b)
+{
+  return a.width == b.width && a.height == b.height &&
+         std::memcmp(a.points.data(), b.points.data(), a.size() * sizeof(PointFlow)) == 0;
+}
+
+template <typename PointT>
+class GridSceneFlowTest : public ::testing::Test {
+protected:
+  using Cloud = pcl::PointCloud<PointT>;
+  static constexpr std::uint32_t WIDTH = 160;
+  static constexpr std::uint32_t HEIGHT = 120;
+
+  GridSceneFlowTest() { estimation_.setCameraIntrinsics(intrinsics_); }
+
+  dynvo::test::RenderedView<PointT>
+  view(const std::vector<TexturedQuad>& quads, const Eigen::Isometry3d& T_world_camera) const
+  {
+    return dynvo::test::render<PointT>(quads, T_world_camera, intrinsics_, WIDTH, HEIGHT);
+  }
+
+  void
+  run(const typename Cloud::ConstPtr& previous, const typename Cloud::ConstPtr& current)
+  {
+    estimation_.setPreviousCloud(previous);
+    estimation_.setInputCloud(current);
+    estimation_.compute(flow_);
+  }
+
+  CameraIntrinsics intrinsics_ = scaledIntrinsics(WIDTH);
+  dynvo::GridSceneFlowEstimation<PointT> estimation_;
+  FlowCloud flow_;
+};
+
+using PointTypes = ::testing::Types<pcl::PointXYZRGB, pcl::PointXYZRGBA>;
+TYPED_TEST_SUITE(GridSceneFlowTest, PointTypes);
+
+TYPED_TEST(GridSceneFlowTest, SameFrameTwiceGivesZeroFlowOnEveryTexturedCell)
+{
+  const auto frame = this->view(staticRoom(), Eigen::Isometry3d::Identity());
+  this->run(frame.cloud, frame.cloud);
+  ASSERT_EQ(this->flow_.width, 10u); // 160 / 16
+  ASSERT_EQ(this->flow_.height, 7u); // 120 / 16
+  expectCellContract(this->flow_);
+  for (const PointFlow& f : this->flow_) {
+    // Every cell sees texture at valid depth, so every cell must be tracked.
+    ASSERT_TRUE(f.valid_3d) << "cell at " << f.u << "," << f.v;
+    // Identical images give a zero LK residual at every level, so the track cannot move;
+    // 1e-3 px and 1e-6 m only absorb float rounding.
+    EXPECT_NEAR(f.prev_u, f.u, 1e-3f);
+    EXPECT_NEAR(f.prev_v, f.v, 1e-3f);
+    EXPECT_LT((prevPoint(f) - currPoint(f)).norm(), 1e-6);
+  }
+}
+
+TYPED_TEST(GridSceneFlowTest, KnownCameraMotionIsRecoveredOnEveryStaticCell)
+{
+  const auto scene = staticRoom();
+  // Previous camera = world; the current one moved by ~2.6 cm and ~1.1 deg (3-5 px of flow).
+  const Eigen::Isometry3d T_world_curr = pose(0.5, 1.0, 0.3, 0.02, -0.01, 0.015);
+  const auto previous = this->view(scene, Eigen::Isometry3d::Identity());
+  const auto current = this->view(scene, T_world_curr);
+  this->run(previous.cloud, current.cloud);
+  expectCellContract(this->flow_);
+  std::vector<double> error_3d, error_2d;
+  for (const PointFlow& f : this->flow_) {
+    if (!f.valid_3d)
+      continue;
+    // b_i is exact (noise-free depth at an integer pixel): its true previous position is known.
+    const Eigen::Vector3d a_true = T_world_curr * currPoint(f);
+    const Eigen::Vector2f p_true = this->intrinsics_.project(a_true.cast<float>());
+    error_3d.push_back((prevPoint(f) - a_true).norm());
+    error_2d.push_back((Eigen::Vector2f(f.prev_u, f.prev_v) - p_true).norm());
+  }
+  // Cells whose window leaves the image or straddles the board's outline may be rejected.
+  ASSERT_GE(error_3d.size(), this->flow_.size() * 8 / 10);
+  // 0.2 px at 1.2-2 m and fx = 131 px is 2-3 mm laterally; 5 mm leaves room for the
+  // bilinear depth on the slanted board.
+  this->RecordProperty("median_error_2d_px", std::to_string(median(error_2d)));
+  this->RecordProperty("median_error_3d_mm", std::to_string(median(error_3d) * 1000.0));
+  EXPECT_LT(median(error_2d), 0.2);
+  EXPECT_LT(median(error_3d), 0.005);
+}
+
+TYPED_TEST(GridSceneFlowTest, MovingObjectCellsCarryTheObjectMotion)
+{
+  auto scene = staticRoom();
+  scene.resize(1); // the wall only
+  TexturedQuad box;
+  box.T_world_quad = pose(0, 0, 0, 0.1, 0.0, 1.2);
+  box.half_width = 0.35;
+  box.half_height = 0.25;
+  box.seed = 5;
+  box.id = 7;
+  const Eigen::Isometry3d T_world_curr = pose(0, 0.5, 0, 0.01, 0, 0);
+  const auto previous = [&] {
+    auto quads = scene;
+    quads.push_back(box);
+    return this->view(quads, Eigen::Isometry3d::Identity());
+  }();
+  // The object moves 4 cm and turns 3 deg about its own z axis, far beyond the static motion.
+  const Eigen::Isometry3d motion = pose(0, 0, 3, -0.03, 0.02, -0.01);
+  TexturedQuad moved = box;
+  moved.T_world_quad = motion * box.T_world_quad;
+  auto quads = scene;
+  quads.push_back(moved);
+  auto current = this->view(quads, T_world_curr);
+  // A missing-depth block (48x32 px, wider than any fillable hole) over the top-left cells.
+  for (std::uint32_t v = 0; v < 32; ++v)
+    for (std::uint32_t u = 0; u < 48; ++u) {
+      auto& p = (*current.cloud)(u, v);
+      p.x = p.y = p.z = std::numeric_limits<float>::quiet_NaN();
+    }
+  this->run(previous.cloud, current.cloud);
+  expectCellContract(this->flow_);
+
+  std::vector<double> object_error;
+  std::size_t object_cells = 0;
+  for (const PointFlow& f : this->flow_) {
+    if (f.u < 48 && f.v < 32) {
+      EXPECT_FALSE(f.valid_3d) << "cell at " << f.u << "," << f.v << " has no depth";
+      EXPECT_TRUE(std::isnan(f.z));
+      continue;
+    }
+    const auto pixel = static_cast<std::size_t>(f.v) * this->WIDTH + static_cast<std::size_t>(f.u);
+    if (current.ids[pixel] != 1)
+      continue;
+    ++object_cells;
+    if (!f.valid_3d)
+      continue;
+    // World point now -> same object point before the motion -> previous camera (= world).
+    const Eigen::Vector3d a_true = motion.inverse() * (T_world_curr * currPoint(f));
+    object_error.push_back((prevPoint(f) - a_true).norm());
+  }
+  ASSERT_GE(object_cells, 8u); // the box spans ~4x3 cells at this size
+  // Cells near the outline see both motions and may be rejected; most must survive.
+  ASSERT_GE(object_error.size() * 2, object_cells);
+  this->RecordProperty("object_median_error_3d_mm", std::to_string(median(object_error) * 1000.0));
+  EXPECT_LT(median(object_error), 0.005); // as for camera motion; the object moves 4-5 cm
+}
+
+TYPED_TEST(GridSceneFlowTest, ShiftCurrentToPreviousMatchesAFreshComputation)
+{
+  const auto scene = staticRoom();
+  const auto f0 = this->view(scene, Eigen::Isometry3d::Identity());
+  const auto f1 = this->view(scene, pose(0, 0.4, 0, 0.01, 0, 0));
+  const auto f2 = this->view(scene, pose(0, 0.8, 0, 0.02, 0.005, 0));
+  this->run(f0.cloud, f1.cloud);
+  this->estimation_.shiftCurrentToPrevious();
+  EXPECT_EQ(this->estimation_.getPreviousCloud(), f1.cloud);
+  EXPECT_FALSE(this->estimation_.getInputCloud());
+  this->estimation_.setInputCloud(f2.cloud);
+  this->estimation_.compute(this->flow_);
+
+  dynvo::GridSceneFlowEstimation<TypeParam> fresh;
+  fresh.setCameraIntrinsics(this->intrinsics_);
+  fresh.setPreviousCloud(f1.cloud);
+  fresh.setInputCloud(f2.cloud);
+  FlowCloud expected;
+  fresh.compute(expected);
+  ASSERT_FALSE(expected.empty());
+  EXPECT_TRUE(identical(this->flow_, expected));
+
+  // A parameter change after the shift must rebuild both frames, not reuse stale pyramids.
+  this->estimation_.setWindowSize(11);
+  this->estimation_.compute(this->flow_);
+  fresh.setWindowSize(11);
+  fresh.compute(expected);
+  EXPECT_TRUE(identical(this->flow_, expected));
+}
+
+TYPED_TEST(GridSceneFlowTest, ResultIsIdenticalForOneAndTwoThreads)
+{
+  const auto scene = staticRoom();
+  const auto previous = this->view(scene, Eigen::Isometry3d::Identity());
+  const auto current = this->view(scene, pose(0.3, 0.6, 0, 0.015, 0, 0.01));
+  this->run(previous.cloud, current.cloud);
+  const FlowCloud single = this->flow_;
+  this->estimation_.setNumberOfThreads(2);
+  this->run(previous.cloud, current.cloud);
+  EXPECT_TRUE(identical(this->flow_, single));
+}
+
+// --- contract ---------------------------------------------------------------------------
+
+class GridSceneFlowContractTest : public ::testing::Test {
+protected:
+  using Cloud = pcl::PointCloud<pcl::PointXYZRGB>;
+
+  /// Runs compute() on an output holding stale content; returns what PCL_ERROR printed.
+  std::string
+  computeCapturingErrors()
+  {
+    flow_.resize(3, 1);
+    ::testing::internal::CaptureStderr();
+    estimation_.compute(flow_);
+    return ::testing::internal::GetCapturedStderr();
+  }
+
+  static Cloud::Ptr
+  organized(std::uint32_t width, std::uint32_t height)
+  {
+    return dynvo::test::render<pcl::PointXYZRGB>(staticRoom(), Eigen::Isometry3d::Identity(),
+                                                 scaledIntrinsics(width), width, height)
+        .cloud;
+  }
+
+  dynvo::GridSceneFlowEstimation<pcl::PointXYZRGB> estimation_;
+  FlowCloud flow_;
+};
+
+TEST_F(GridSceneFlowContractTest, MissingInputsGiveClearedOutputAndAnError)
+{
+  EXPECT_NE(computeCapturingErrors().find("[dynvo::GridSceneFlowEstimation::compute]"),
+            std::string::npos);
+  EXPECT_TRUE(flow_.empty());
+  estimation_.setInputCloud(organized(32, 32));
+  EXPECT_NE(computeCapturingErrors().find("previous"), std::string::npos);
+  EXPECT_TRUE(flow_.empty());
+}
+
+TEST_F(GridSceneFlowContractTest, UnorganizedMismatchedOrTooSmallInputsGiveClearedOutput)
+{
+  const Cloud::Ptr frame = organized(32, 32);
+  Cloud::Ptr unorganized(new Cloud(*frame));
+  unorganized->width = static_cast<std::uint32_t>(unorganized->size());
+  unorganized->height = 1;
+  estimation_.setPreviousCloud(frame);
+  estimation_.setInputCloud(unorganized);
+  EXPECT_NE(computeCapturingErrors().find("not organized"), std::string::npos);
+  EXPECT_TRUE(flow_.empty());
+
+  estimation_.setInputCloud(organized(48, 32));
+  EXPECT_NE(computeCapturingErrors().find("48x32 but previous cloud is 32x32"),
+            std::string::npos);
+  EXPECT_TRUE(flow_.empty());
+
+  estimation_.setInputCloud(frame);
+  estimation_.setCellSize(40); // larger than the 32x32 image
+  EXPECT_NE(computeCapturingErrors().find("no 40 px grid cell"), std::string::npos);
+  EXPECT_TRUE(flow_.empty());
+}
+
+TEST_F(GridSceneFlowContractTest, VgaPairGivesAFortyByThirtyGridOnCellCentres)
+{
+  const Cloud::Ptr previous = organized(640, 480);
+  const Cloud::Ptr current = dynvo::test::render<pcl::PointXYZRGB>(
+                                 staticRoom(), pose(0, 0.5, 0, 0.01, 0, 0),
+                                 scaledIntrinsics(640), 640, 480)
+                                 .cloud;
+  current->header.stamp = 42;
+  estimation_.setCameraIntrinsics(scaledIntrinsics(640));
+  estimation_.setPreviousCloud(previous);
+  estimation_.setInputCloud(current);
+  estimation_.compute(flow_);
+  ASSERT_EQ(flow_.width, 40u);
+  ASSERT_EQ(flow_.height, 30u);
+  EXPECT_FALSE(flow_.is_dense);
+  EXPECT_EQ(flow_.header.stamp, 42u);
+  for (std::uint32_t row = 0; row < 30; ++row)
+    for (std::uint32_t col = 0; col < 40; ++col) {
+      EXPECT_EQ(flow_(col, row).u, 16.0f * col + 8.0f);
+      EXPECT_EQ(flow_(col, row).v, 16.0f * row + 8.0f);
+    }
+  expectCellContract(flow_);
+  const auto valid = std::count_if(flow_.begin(), flow_.end(),
+                                   [](const PointFlow& f) { return f.valid_3d != 0; });
+  EXPECT_GE(valid, 1100); // textured scene, small motion: only border cells may fail
+}
+
+TEST_F(GridSceneFlowContractTest, BadParametersThrowAndKeepTheOldValue)
+{
+  EXPECT_THROW(estimation_.setCellSize(1), std::invalid_argument);
+  EXPECT_EQ(estimation_.getCellSize(), 16);
+  EXPECT_THROW(estimation_.setWindowSize(2), std::invalid_argument);
+  EXPECT_THROW(estimation_.setMaxPyramidLevel(-1), std::invalid_argument);
+  EXPECT_THROW(estimation_.setMaxIterations(0), std::invalid_argument);
+  EXPECT_THROW(estimation_.setEpsilon(0.0), std::invalid_argument);
+  EXPECT_THROW(estimation_.setMinEigenThreshold(-1.0), std::invalid_argument);
+  EXPECT_THROW(estimation_.setForwardBackwardThreshold(0.0f), std::invalid_argument);
+  EXPECT_THROW(estimation_.setDepthEdgeTolerance(-0.1f), std::invalid_argument);
+  EXPECT_THROW(estimation_.setMaxFlow(0.0f), std::invalid_argument);
+  EXPECT_THROW(estimation_.setWeightReferenceDepth(0.0f), std::invalid_argument);
+  EXPECT_THROW(estimation_.setMinDepth(6.0f), std::invalid_argument); // above z_max
+  EXPECT_EQ(estimation_.getMinDepth(), 0.3f);
+  EXPECT_THROW(estimation_.setMaxHoleWidth(-2), std::invalid_argument);
+  EXPECT_THROW(estimation_.setFlyingPixelTolerance(0.0f), std::invalid_argument);
+  EXPECT_THROW(estimation_.setHoleFillTolerance(std::nanf("")), std::invalid_argument);
+  EXPECT_THROW(estimation_.setNumberOfThreads(0), std::invalid_argument);
+  EXPECT_THROW(estimation_.setCameraIntrinsics({0.0, 525.0, 319.5, 239.5}),
+               std::invalid_argument);
+  dynvo::GridSceneFlowParameters parameters;
+  parameters.max_flow = -1.0f;
+  EXPECT_THROW(estimation_.setParameters(parameters), std::invalid_argument);
+  EXPECT_EQ(estimation_.getMaxFlow(), dynvo::GridSceneFlowParameters{}.max_flow);
+}
+
+} // namespace

@@ -1,0 +1,206 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <dynvo/app/odometry_pipeline.h>
+#include <dynvo/common/conventions.h>
+#include <dynvo/motion_segmentation/rigid_motion_segmentation.h>
+#include <dynvo/registration/static_scene_registration.h>
+#include <dynvo/scene_flow/grid_scene_flow_estimation.h>
+
+#include <Eigen/SVD>
+
+#include <chrono>
+#include <stdexcept>
+
+namespace dynvo::app {
+
+namespace {
+
+using Cloud = pcl::PointCloud<pcl::PointXYZRGB>;
+using Clock = std::chrono::steady_clock;
+
+double
+millisecondsSince(Clock::time_point start)
+{
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+/// Projects the rotation of a pose back onto SO(3) (drift of repeated products).
+void
+orthonormalize(Eigen::Matrix4d& T)
+{
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(T.topLeftCorner<3, 3>(),
+                                        Eigen::ComputeFullU | Eigen::ComputeFullV);
+  T.topLeftCorner<3, 3>() = svd.matrixU() * svd.matrixV().transpose();
+}
+
+/// Rigid inverse of a pose.
+Eigen::Matrix4d
+inverse(const Eigen::Matrix4d& T)
+{
+  Eigen::Matrix4d inv = Eigen::Matrix4d::Identity();
+  inv.topLeftCorner<3, 3>() = T.topLeftCorner<3, 3>().transpose();
+  inv.topRightCorner<3, 1>() = -inv.topLeftCorner<3, 3>() * T.topRightCorner<3, 1>();
+  return inv;
+}
+
+/// Centre pixel of every valid_3d cell: the whole valid flow counts as static (ablation).
+pcl::IndicesPtr
+allValidCells(const pcl::PointCloud<PointFlow>& flow, std::uint32_t image_width)
+{
+  auto indices = pcl::make_shared<pcl::Indices>();
+  for (const PointFlow& cell : flow)
+    if (cell.valid_3d)
+      indices->push_back(static_cast<int>(cell.v) * static_cast<int>(image_width) +
+                         static_cast<int>(cell.u));
+  return indices;
+}
+
+} // namespace
+
+void
+PipelineOptions::validate() const
+{
+  intrinsics.validate();
+  scene_flow.validate();
+  segmentation.validate();
+  registration.validate();
+  if (threads == 0)
+    throw std::invalid_argument("[dynvo::app::PipelineOptions] threads must be at least 1");
+  if (segmentation.cell_size != scene_flow.cell_size)
+    throw std::invalid_argument(
+        "[dynvo::app::PipelineOptions] segmentation cell_size " +
+        std::to_string(segmentation.cell_size) + " differs from scene flow cell_size " +
+        std::to_string(scene_flow.cell_size));
+}
+
+struct OdometryPipeline::Impl {
+  explicit Impl(const PipelineOptions& o) : options(o)
+  {
+    options.validate();
+    flow_estimation.setCameraIntrinsics(options.intrinsics);
+    flow_estimation.setParameters(options.scene_flow);
+    flow_estimation.setNumberOfThreads(options.threads);
+    segmentation.setCameraIntrinsics(options.intrinsics);
+    segmentation.setParameters(options.segmentation);
+    segmentation.setNumberOfThreads(options.threads);
+    registration.setParameters(options.registration);
+  }
+
+  void
+  track(const Cloud::ConstPtr& cloud)
+  {
+    const auto flow_start = Clock::now();
+    flow_estimation.shiftCurrentToPrevious();
+    flow_estimation.setInputCloud(cloud);
+    auto flow = pcl::make_shared<pcl::PointCloud<PointFlow>>();
+    flow_estimation.compute(*flow);
+    result.times.scene_flow_ms = millisecondsSince(flow_start);
+
+    const auto segmentation_start = Clock::now();
+    pcl::IndicesPtr static_indices;
+    if (options.use_segmentation) {
+      segmentation.setInputCloud(cloud);
+      segmentation.setInputFlow(flow);
+      segmentation.setPredictedMotion(T_curr_prev_predicted.cast<float>());
+      segmentation.segment(result.segments);
+      result.segment_labels = segmentation.getSegmentLabels();
+      result.motions = segmentation.getMotions();
+      static_indices = pcl::make_shared<pcl::Indices>(
+          result.segments.empty() ? pcl::Indices{} : result.segments[0].indices);
+    }
+    else {
+      static_indices = allValidCells(*flow, cloud->width);
+    }
+    result.times.segmentation_ms = millisecondsSince(segmentation_start);
+
+    const auto registration_start = Clock::now();
+    registration.setInputSource(cloud);
+    registration.setInputTarget(previous);
+    registration.setIndices(static_indices);
+    registration.setInputFlow(flow);
+    Cloud aligned;
+    registration.align(aligned, inverse(T_curr_prev_predicted).cast<float>());
+    result.lost = !registration.hasConverged();
+    result.T_curr_prev = result.lost
+                             ? T_curr_prev_predicted
+                             : inverse(registration.getFinalTransformation().cast<double>());
+    result.times.registration_ms = millisecondsSince(registration_start);
+  }
+
+  void
+  paintLabels()
+  {
+    result.labels.assign(static_cast<std::size_t>(result.width) * result.height, LABEL_NONE);
+    for (std::size_t s = 0; s < result.segments.size(); ++s)
+      for (const auto index : result.segments[s].indices)
+        result.labels[index] = result.segment_labels[s];
+  }
+
+  PipelineOptions options;
+  GridSceneFlowEstimation<pcl::PointXYZRGB> flow_estimation;
+  RigidMotionSegmentation<pcl::PointXYZRGB> segmentation;
+  StaticSceneRegistration<pcl::PointXYZRGB> registration;
+  Cloud::ConstPtr previous;
+  Eigen::Matrix4d T_world_prev = Eigen::Matrix4d::Identity();
+  Eigen::Matrix4d T_curr_prev_predicted = Eigen::Matrix4d::Identity();
+  std::size_t frames = 0;
+  FrameResult result;
+};
+
+OdometryPipeline::OdometryPipeline(const PipelineOptions& options)
+: impl_(std::make_unique<Impl>(options))
+{}
+
+OdometryPipeline::~OdometryPipeline() = default;
+
+const FrameResult&
+OdometryPipeline::process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& cloud,
+                          double timestamp)
+{
+  Impl& p = *impl_;
+  if (!cloud || !cloud->isOrganized())
+    throw std::invalid_argument(
+        "[dynvo::app::OdometryPipeline::process] the frame must be an organized cloud");
+  if (p.previous &&
+      (cloud->width != p.previous->width || cloud->height != p.previous->height))
+    throw std::invalid_argument(
+        "[dynvo::app::OdometryPipeline::process] frame size changed from " +
+        std::to_string(p.previous->width) + "x" + std::to_string(p.previous->height) +
+        " to " + std::to_string(cloud->width) + "x" + std::to_string(cloud->height));
+
+  const auto start = Clock::now();
+  FrameResult& result = p.result;
+  result = FrameResult{};
+  result.timestamp = timestamp;
+  result.width = cloud->width;
+  result.height = cloud->height;
+  if (p.frames == 0) {
+    p.flow_estimation.setInputCloud(cloud);
+  }
+  else {
+    p.track(cloud);
+    result.T_world_curr = p.T_world_prev * inverse(result.T_curr_prev);
+    if (p.frames % 100 == 0)
+      orthonormalize(result.T_world_curr);
+    p.T_curr_prev_predicted = result.T_curr_prev;
+  }
+  p.paintLabels();
+  p.T_world_prev = result.T_world_curr;
+  p.previous = cloud;
+  ++p.frames;
+  result.times.total_ms = millisecondsSince(start);
+  return result;
+}
+
+void
+OdometryPipeline::reset()
+{
+  impl_ = std::make_unique<Impl>(impl_->options);
+}
+
+std::size_t
+OdometryPipeline::frameCount() const
+{
+  return impl_->frames;
+}
+
+} // namespace dynvo::app

@@ -1,0 +1,110 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Per-frame cost of the rigid motion segmentation stages at VGA (1200 cells, h_max 20).
+#include <dynvo/io/frame.h>
+#include <dynvo/motion_segmentation/rigid_motion_segmentation.h>
+#include <dynvo/scene_flow/grid_scene_flow_estimation.h>
+#include <dynvo/synth/scene_synthesizer.h>
+
+#include <pcl/point_types.h>
+
+#include <benchmark/benchmark.h>
+
+#include <vector>
+
+namespace {
+
+using Point = pcl::PointXYZRGB;
+
+/// One VGA frame of static_two (static camera, two moving boxes) with its flow from k-1.
+struct FlowFrame {
+  pcl::PointCloud<Point>::Ptr cloud;
+  pcl::PointCloud<dynvo::PointFlow>::Ptr flow;
+};
+
+/// Frames 1..FRAMES of static_two with and without the Kinect depth model, made once
+/// (rendering and scene flow are not timed).
+constexpr int FRAMES = 12;
+
+const std::vector<FlowFrame>&
+sequence(bool noise)
+{
+  static const auto make = [](bool with_noise) {
+    dynvo::SynthOptions options;
+    options.scenario = "static_two";
+    options.frames = FRAMES + 1;
+    options.noise = with_noise;
+    const dynvo::SceneSynthesizer synth(options);
+    dynvo::GridSceneFlowEstimation<Point> estimation;
+    estimation.setCameraIntrinsics(synth.intrinsics());
+    std::vector<FlowFrame> frames;
+    for (int k = 0; k <= FRAMES; ++k) {
+      const dynvo::SynthFrame frame = synth.render(k);
+      FlowFrame f;
+      f.cloud = dynvo::makeOrganizedCloud(frame.color, frame.depth, synth.intrinsics());
+      f.flow.reset(new pcl::PointCloud<dynvo::PointFlow>);
+      estimation.shiftCurrentToPrevious();
+      estimation.setInputCloud(f.cloud);
+      if (k > 0) {
+        estimation.compute(*f.flow);
+        frames.push_back(f);
+      }
+    }
+    return frames;
+  };
+  static const std::vector<FlowFrame> clean = make(false);
+  static const std::vector<FlowFrame> noisy = make(true);
+  return noise ? noisy : clean;
+}
+
+/// §3 alone (hypotheses, refinement, DBSCAN, labelling) on plain buffers. Arg: noise.
+void
+BM_SpatialSegmentation(benchmark::State& state)
+{
+  const std::vector<FlowFrame>& frames = sequence(state.range(0) == 1);
+  std::vector<dynvo::GridFlowData> grids(frames.size());
+  for (std::size_t k = 0; k < frames.size(); ++k)
+    grids[k].assign(*frames[k].flow, 16);
+  const dynvo::RigidMotionSegmentationParameters params;
+  dynvo::SpatialSegmenter segmenter;
+  dynvo::SpatialSegmentationResult result;
+  std::size_t k = 0;
+  for (auto _ : state) {
+    segmenter.segment(grids[k++ % grids.size()], params, result);
+    benchmark::DoNotOptimize(result.labels.data());
+  }
+}
+BENCHMARK(BM_SpatialSegmentation)
+    ->ArgName("noise")
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+/// RigidMotionSegmentation::segment() per frame, including the pixel indices.
+/// Args: noise, tracking, threads.
+void
+BM_RigidMotionSegmentation(benchmark::State& state)
+{
+  const std::vector<FlowFrame>& frames = sequence(state.range(0) == 1);
+  dynvo::RigidMotionSegmentation<Point> segmentation;
+  segmentation.setTracking(state.range(1) == 1);
+  segmentation.setNumberOfThreads(static_cast<unsigned>(state.range(2)));
+  std::vector<pcl::PointIndices> segments;
+  std::size_t k = 0;
+  for (auto _ : state) {
+    const FlowFrame& frame = frames[k++ % frames.size()];
+    segmentation.setInputCloud(frame.cloud);
+    segmentation.setInputFlow(frame.flow);
+    segmentation.segment(segments);
+    benchmark::DoNotOptimize(segments.data());
+  }
+}
+BENCHMARK(BM_RigidMotionSegmentation)
+    ->ArgNames({"noise", "tracking", "threads"})
+    ->Args({0, 0, 1})
+    ->Args({1, 0, 1})
+    ->Args({0, 0, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+} // namespace

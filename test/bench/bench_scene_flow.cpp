@@ -1,0 +1,115 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Per-frame cost of the grid scene flow stage at VGA on real TUM fr1/xyz frames.
+#include <dynvo/io/tum_folder_source.h>
+#include <dynvo/scene_flow/depth_preprocessing.h>
+#include <dynvo/scene_flow/grid_scene_flow_estimation.h>
+
+#include <pcl/point_types.h>
+
+#include <benchmark/benchmark.h>
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace {
+
+using Cloud = pcl::PointCloud<pcl::PointXYZRGB>;
+
+/// Frames 0..FRAMES-1 of the shared fr1/xyz clip, loaded once (PNG decoding is not timed).
+constexpr std::size_t FRAMES = 30;
+
+const std::vector<dynvo::Frame>&
+frames()
+{
+  static const std::vector<dynvo::Frame> loaded = [] {
+    std::vector<dynvo::Frame> result;
+    const std::string folder = std::string(DYNVO_SHARED_DATA_DIR) + "/tum_fr1_xyz_200";
+    if (!std::filesystem::exists(folder + "/rgb.txt"))
+      return result;
+    dynvo::TumFolderSource::Options options;
+    options.intrinsics = dynvo::CameraIntrinsics::fromPreset("fr1");
+    const dynvo::TumFolderSource source(folder, options);
+    for (std::size_t k = 0; k < FRAMES && k < source.size(); ++k)
+      result.push_back(source.read(k));
+    return result;
+  }();
+  return loaded;
+}
+
+/// Frame order 0, 1, ..., N-1, N-2, ..., 1, 0, 1, ...: every step is a real consecutive pair.
+std::size_t
+pingPong(std::size_t step, std::size_t n)
+{
+  const std::size_t period = 2 * (n - 1);
+  const std::size_t phase = step % period;
+  return phase < n ? phase : period - phase;
+}
+
+bool
+skipWithoutData(benchmark::State& state)
+{
+  if (frames().size() >= 2)
+    return false;
+  state.SkipWithError("tum_fr1_xyz_200 not found under DYNVO_SHARED_DATA_DIR");
+  return true;
+}
+
+/// The whole stage per frame as a sequence runs it: depth preprocessing, one grey pyramid,
+/// forward LK, the forward-backward check and back-projection. Arg: thread count.
+void
+BM_GridSceneFlowPerFrame(benchmark::State& state)
+{
+  if (skipWithoutData(state))
+    return;
+  dynvo::GridSceneFlowEstimation<pcl::PointXYZRGB> estimation;
+  estimation.setCameraIntrinsics(dynvo::CameraIntrinsics::fromPreset("fr1"));
+  estimation.setNumberOfThreads(static_cast<unsigned>(state.range(0)));
+  if (state.range(1) == 1)
+    estimation.setForwardBackwardCheck(dynvo::ForwardBackwardCheck::full);
+  pcl::PointCloud<dynvo::PointFlow> flow;
+  const std::size_t n = frames().size();
+  std::size_t step = 0;
+  estimation.setInputCloud(frames()[0].cloud);
+  for (auto _ : state) {
+    estimation.shiftCurrentToPrevious();
+    estimation.setInputCloud(frames()[pingPong(++step, n)].cloud);
+    estimation.compute(flow);
+    benchmark::DoNotOptimize(flow.points.data());
+  }
+  state.SetLabel(state.range(1) == 1 ? "fb=full" : "fb=local");
+}
+BENCHMARK(BM_GridSceneFlowPerFrame)
+    ->ArgNames({"threads", "full_fb"})
+    ->Args({1, 0})
+    ->Args({2, 0})
+    ->Args({1, 1})
+    ->Args({2, 1})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(2.0);
+
+/// Depth preprocessing alone (ALGORITHM.md §1.1) on one VGA depth map. Arg: thread count.
+void
+BM_DepthPreprocessing(benchmark::State& state)
+{
+  if (skipWithoutData(state))
+    return;
+  dynvo::DepthPreprocessing preprocessing;
+  preprocessing.setNumberOfThreads(static_cast<unsigned>(state.range(0)));
+  const dynvo::DepthImage& depth = frames()[1].depth;
+  std::vector<float> out;
+  for (auto _ : state) {
+    preprocessing.apply(depth.data, depth.width, depth.height, out);
+    benchmark::DoNotOptimize(out.data());
+  }
+}
+BENCHMARK(BM_DepthPreprocessing)
+    ->ArgName("threads")
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+} // namespace
