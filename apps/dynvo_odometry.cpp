@@ -9,6 +9,11 @@
 #include <dynvo/io/label_io.h>
 #include <dynvo/io/trajectory_io.h>
 
+#ifdef DYNVO_WITH_VTK
+#include <dynvo/vis/label_renderer.h>
+#include <dynvo/vis/trajectory_plot.h>
+#endif
+
 #include <pcl/console/print.h>
 #include <pcl/exceptions.h>
 
@@ -39,6 +44,8 @@ options()
       {"seed", "S", "hypothesis sampling seed (default 0)"},
       {"no_segmentation", "", "ablation: every valid flow cell counts as static"},
       {"refine", "none|icp|gicp", "refinement of the static registration (default none)"},
+      {"render_dir", "DIR", "render label-coloured views and trajectory.png (needs X: xvfb-run -a)"},
+      {"render_every", "N", "render every N-th frame (default 10)"},
       {"config", "FILE", "YAML with every parameter (see -write_config)"},
       {"write_config", "FILE", "write the effective configuration as YAML and exit"},
       {"v", "", "verbose (PCL debug messages)"},
@@ -73,6 +80,69 @@ pipelineOptions(const dynvo::app::Arguments& args)
   options.validate();
   return options;
 }
+
+/// Renders every N-th frame during the run and the trajectory plot at its end. Without a
+/// display the renderer warns once and the run carries on without images.
+class RunRenderer {
+public:
+  RunRenderer(const dynvo::app::Arguments& args, const dynvo::CameraIntrinsics& intrinsics)
+  : dir_(args.string("render_dir")), every_(args.integer("render_every", 10))
+  {
+    if (every_ < 1)
+      throw UsageError("-render_every must be >= 1");
+#ifdef DYNVO_WITH_VTK
+    params_.intrinsics = intrinsics;
+    if (!dir_.empty())
+      fs::create_directories(dir_);
+#else
+    (void)intrinsics;
+    if (!dir_.empty())
+      throw UsageError("-render_dir: dynvo was built without VTK (DYNVO_WITH_VTK=OFF)");
+#endif
+  }
+
+  void
+  add(const dynvo::Frame& frame, const dynvo::app::FrameResult& result,
+      const dynvo::Trajectory& trajectory)
+  {
+#ifdef DYNVO_WITH_VTK
+    if (dir_.empty() || (trajectory.size() - 1) % every_ != 0)
+      return;
+    params_.width = frame.cloud->width;
+    params_.height = frame.cloud->height;
+    renderer_.setParameters(params_);
+    const std::string name = fs::path(dynvo::labelFileName(frame.timestamp)).stem().string();
+    renderer_.render(*frame.cloud, result.labels, trajectory.back().T_world_camera, trajectory,
+                     (fs::path(dir_) / (name + "_camera.png")).string());
+#else
+    (void)frame, (void)result, (void)trajectory;
+#endif
+  }
+
+  void
+  finish(const dynvo::Trajectory& estimate, const dynvo::Trajectory& groundtruth)
+  {
+#ifdef DYNVO_WITH_VTK
+    if (dir_.empty() || estimate.size() < 2)
+      return;
+    const std::string plot = (fs::path(dir_) / "trajectory.png").string();
+    const auto aligned =
+        groundtruth.empty() ? estimate : dynvo::alignToGroundTruth(groundtruth, estimate);
+    if (dynvo::writeTrajectoryPlot(aligned, groundtruth, plot, {}))
+      std::printf("rendered frames and %s\n", plot.c_str());
+#else
+    (void)estimate, (void)groundtruth;
+#endif
+  }
+
+private:
+  std::string dir_;
+  long every_;
+#ifdef DYNVO_WITH_VTK
+  dynvo::LabelRenderer::Parameters params_;
+  dynvo::LabelRenderer renderer_;
+#endif
+};
 
 } // namespace
 
@@ -113,6 +183,7 @@ main(int argc, char** argv)
                                    args.string("objects"),
                                    args.has("init_gt") ? &groundtruth : nullptr);
     dynvo::app::OdometryPipeline pipeline(options);
+    RunRenderer renderer(args, options.intrinsics);
     dynvo::app::RunReport report(max_frames > 0 ? std::min<std::size_t>(max_frames, source->size())
                                                 : source->size());
     dynvo::Frame frame;
@@ -122,6 +193,7 @@ main(int argc, char** argv)
              source->next(frame)) {
         const auto& result = pipeline.process(frame.cloud, frame.timestamp);
         outputs.add(result);
+        renderer.add(frame, result, outputs.trajectory());
         report.add(result);
       }
     }
@@ -132,9 +204,10 @@ main(int argc, char** argv)
       status = 1;
     }
     outputs.finish();
-    report.printSummary();
-    if (!groundtruth.empty() && outputs.trajectory().size() >= 2)
-      report.printAccuracy(groundtruth, outputs.trajectory());
+    renderer.finish(outputs.trajectory(), groundtruth);
+    report.printSummary(groundtruth.empty()
+                            ? ""
+                            : dynvo::app::RunReport::accuracy(groundtruth, outputs.trajectory()));
     return status;
   });
 }

@@ -4,6 +4,7 @@
 #include <dynvo/app/frame_source_args.h>
 #include <dynvo/common/timestamps.h>
 #include <dynvo/eval/trajectory_metrics.h>
+#include <dynvo/io/label_io.h>
 #include <dynvo/io/trajectory_io.h>
 #include <dynvo/vis/display.h>
 #include <dynvo/vis/label_renderer.h>
@@ -12,8 +13,6 @@
 #include <pcl/console/print.h>
 #include <pcl/console/time.h>
 #include <pcl/exceptions.h>
-
-#include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
 #include <cstdio>
@@ -60,27 +59,18 @@ parseFrameList(const std::string& text)
   return frames;
 }
 
-/// The label PNG of a frame (uint8, the cloud's size); empty when the file does not exist.
+/// The label PNG of a frame (the cloud's size); empty when the file does not exist.
 /// \throws pcl::IOException when it exists but is not such an image
 std::vector<std::uint8_t>
 readLabels(const std::string& path, const pcl::PointCloud<pcl::PointXYZRGB>& cloud)
 {
   if (!fs::exists(path))
     return {};
-  const cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
-  if (image.type() != CV_8UC1 || static_cast<std::uint32_t>(image.cols) != cloud.width ||
-      static_cast<std::uint32_t>(image.rows) != cloud.height)
-    throw pcl::IOException(path + ": expected an 8-bit single-channel PNG of " +
+  dynvo::LabelImage labels = dynvo::readLabelImage(path);
+  if (labels.width != cloud.width || labels.height != cloud.height)
+    throw pcl::IOException(path + ": expected a label image of " +
                            std::to_string(cloud.width) + "x" + std::to_string(cloud.height));
-  return std::vector<std::uint8_t>(image.begin<std::uint8_t>(), image.end<std::uint8_t>());
-}
-
-std::string
-stampName(double timestamp)
-{
-  char text[64];
-  std::snprintf(text, sizeof(text), "%.6f", timestamp);
-  return text;
+  return std::move(labels.data);
 }
 
 /// "Rendered N frames into DIR: first X ms, later mean Y ms, max Z ms" (render + PNG write).
@@ -189,7 +179,7 @@ main(int argc, char** argv)
     for (long index = 0; source->next(frame); ++index) {
       if (frames.empty() ? index % every != 0 : frames.count(index) == 0)
         continue;
-      const std::string stamp = stampName(frame.timestamp);
+      const std::string stamp = fs::path(dynvo::labelFileName(frame.timestamp)).stem().string();
       const std::size_t k = estimate.empty() ? 0 : dynvo::findClosestIndex(stamps, frame.timestamp);
       const auto labels = readLabels((labels_dir / (stamp + ".png")).string(), *frame.cloud);
       if (estimate.empty() || std::abs(stamps[k] - frame.timestamp) > POSE_STAMP_TOLERANCE ||
@@ -211,17 +201,8 @@ main(int argc, char** argv)
         return 1;
       render_ms.push_back(timer.toc());
     }
-    if (!groundtruth.empty()) {
-      // Plot the estimate in the ground truth's frame (no alignment with fewer than 3 pairs).
-      try {
-        const auto T = dynvo::computeAte(groundtruth, estimate).T_groundtruth_estimate;
-        for (auto& pose : estimate)
-          pose.T_world_camera = T * pose.T_world_camera;
-      }
-      catch (const std::invalid_argument& e) {
-        pcl::console::print_warn("Ground truth not aligned: %s\n", e.what());
-      }
-    }
+    if (!groundtruth.empty())
+      estimate = dynvo::alignToGroundTruth(groundtruth, estimate);
     if (!estimate.empty() && !dynvo::writeTrajectoryPlot(estimate, groundtruth,
                                                          (out_dir / "trajectory.png").string(), plot))
       return 1;

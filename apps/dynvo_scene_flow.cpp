@@ -21,7 +21,8 @@ namespace {
 
 const char* const USAGE =
     "dynvo_scene_flow (-tum_dir DIR | -pcd_dir DIR | -oni FILE) -frame I -out flow.pcd "
-    "[-png flow.png] [-threads N] [-cell_size PX] [-window_size PX] [-max_pyramid_level L] "
+    "[-png flow.png] [-threads N] [-cell_size PX] [-window_size PX] "
+    "[-max_pyramid_level L] "
     "[-fb_check full|local]";
 
 /// Draws each cell's 2D track over the current colour image and writes it as PNG.
@@ -41,7 +42,8 @@ writeTrackImage(const std::string& path,
       continue;
     }
     // Green: 2D and 3D valid; yellow: tracked but no usable depth.
-    const cv::Scalar colour = f.valid_3d ? cv::Scalar(0, 255, 0) : cv::Scalar(0, 255, 255);
+    const cv::Scalar colour =
+        f.valid_3d ? cv::Scalar(0, 255, 0) : cv::Scalar(0, 255, 255);
     cv::line(image, c, cv::Point2f(f.prev_u, f.prev_v), colour, 1, cv::LINE_AA);
     cv::circle(image, c, 2, colour, cv::FILLED, cv::LINE_AA);
   }
@@ -57,25 +59,32 @@ main(int argc, char** argv)
   return dynvo::app::runApp(USAGE, [&] {
     const dynvo::GridSceneFlowParameters defaults;
     const long hardware_threads = std::max(1U, std::thread::hardware_concurrency());
-    const auto text = [](auto value) { return std::to_string(value); };
+    const auto text = [](auto value) {
+      return std::to_string(value);
+    };
     std::vector<dynvo::app::Option> options = dynvo::app::frameSourceOptions();
     options.insert(
         options.end(),
         {{"frame", "I", "flow from frame I-1 to frame I, 0-based (required, >= 1)"},
          {"out", "FILE", "PointFlow grid written as binary PCD (required)"},
          {"png", "FILE", "also draw the 2D tracks over frame I"},
-         {"threads", "N", "worker threads (default: hardware count, " + text(hardware_threads) + ")"},
-         {"cell_size", "PX", "grid cell size (default " + text(defaults.cell_size) + ")"},
-         {"window_size", "PX", "LK window side (default " + text(defaults.window_size) + ")"},
-         {"max_pyramid_level", "L", "LK pyramid levels above the image (default " +
-                                        text(defaults.max_pyramid_level) + ")"},
+         {"threads", "N",
+          "worker threads (default: hardware count, " + text(hardware_threads) + ")"},
+         {"cell_size", "PX",
+          "grid cell size (default " + text(defaults.cell_size) + ")"},
+         {"window_size", "PX",
+          "LK window side (default " + text(defaults.window_size) + ")"},
+         {"max_pyramid_level", "L",
+          "LK pyramid levels above the image (default " +
+              text(defaults.max_pyramid_level) + ")"},
          {"fb_check", "full|local", "forward-backward scheme (default local)"}});
     const dynvo::app::Arguments args(argc, argv, options, 0);
     if (args.helpRequested()) {
-      std::printf("Usage: %s\n\nComputes the grid scene flow (ALGORITHM.md section 1) between "
-                  "two consecutive frames.\nIn the PCD, x y z is the current point and prev_x "
-                  "prev_y prev_z the previous one (metres).\n\n%s",
-                  USAGE, args.optionsHelp().c_str());
+      std::printf(
+          "Usage: %s\n\nComputes the grid scene flow (ALGORITHM.md section 1) between "
+          "two consecutive frames.\nIn the PCD, x y z is the current point and prev_x "
+          "prev_y prev_z the previous one (metres).\n\n%s",
+          USAGE, args.optionsHelp().c_str());
       return 0;
     }
     if (!args.has("frame") || !args.has("out"))
@@ -85,10 +94,13 @@ main(int argc, char** argv)
       throw dynvo::app::UsageError("-frame must be >= 1, got " + text(frame_index));
     const long threads = args.integer("threads", hardware_threads);
     if (threads < 1 || threads > 256)
-      throw dynvo::app::UsageError("-threads must be in [1, 256], got " + text(threads));
+      throw dynvo::app::UsageError("-threads must be in [1, 256], got " +
+                                   text(threads));
     dynvo::GridSceneFlowParameters parameters;
-    parameters.cell_size = static_cast<int>(args.integer("cell_size", defaults.cell_size));
-    parameters.window_size = static_cast<int>(args.integer("window_size", defaults.window_size));
+    parameters.cell_size =
+        static_cast<int>(args.integer("cell_size", defaults.cell_size));
+    parameters.window_size =
+        static_cast<int>(args.integer("window_size", defaults.window_size));
     parameters.max_pyramid_level =
         static_cast<int>(args.integer("max_pyramid_level", defaults.max_pyramid_level));
     const std::string fb_check = args.string("fb_check", "local");
@@ -113,8 +125,8 @@ main(int argc, char** argv)
     for (long k = 0; k <= frame_index; ++k) {
       std::swap(previous, current);
       if (!source->next(current))
-        throw std::runtime_error("the recording has only " + text(k) + " frames, need " +
-                                 text(frame_index + 1));
+        throw std::runtime_error("the recording has only " + text(k) +
+                                 " frames, need " + text(frame_index + 1));
     }
     estimation.setPreviousCloud(previous.cloud);
     estimation.setInputCloud(current.cloud);
@@ -124,20 +136,24 @@ main(int argc, char** argv)
     estimation.compute(flow);
     const double milliseconds = timer.toc();
     if (flow.empty())
-      throw std::runtime_error("no flow between " + previous.name + " and " + current.name);
+      throw std::runtime_error("no flow between " + previous.name + " and " +
+                               current.name);
 
     pcl::io::savePCDFileBinary(args.string("out"), flow);
     if (args.has("png"))
       writeTrackImage(args.string("png"), current.color, flow);
     const auto count = [&](auto member) {
-      return std::count_if(flow.begin(), flow.end(),
-                           [&](const dynvo::PointFlow& f) { return f.*member != 0; });
+      return std::count_if(flow.begin(), flow.end(), [&](const dynvo::PointFlow& f) {
+        return f.*member != 0;
+      });
     };
     pcl::console::print_highlight("Flow %s -> %s: %ux%u cells, ", previous.name.c_str(),
                                   current.name.c_str(), flow.width, flow.height);
-    pcl::console::print_value("%ld", static_cast<long>(count(&dynvo::PointFlow::valid_2d)));
+    pcl::console::print_value("%ld",
+                              static_cast<long>(count(&dynvo::PointFlow::valid_2d)));
     pcl::console::print_info(" tracked, ");
-    pcl::console::print_value("%ld", static_cast<long>(count(&dynvo::PointFlow::valid_3d)));
+    pcl::console::print_value("%ld",
+                              static_cast<long>(count(&dynvo::PointFlow::valid_3d)));
     pcl::console::print_info(" with 3D, in ");
     pcl::console::print_value("%.2f", milliseconds);
     pcl::console::print_info(" ms (%ld thread(s), both frames prepared)\n", threads);

@@ -23,8 +23,9 @@
 
 namespace {
 
-const char* const USAGE = "dynvo_segment (-tum_dir DIR | -pcd_dir DIR | -oni FILE) -out_dir LABELS "
-                          "[-no_tracking] [-max_frames N] [-objects FILE] [-threads N] [-seed S]";
+const char* const USAGE =
+    "dynvo_segment (-tum_dir DIR | -pcd_dir DIR | -oni FILE) -out_dir LABELS "
+    "[-no_tracking] [-max_frames N] [-objects FILE] [-threads N] [-seed S]";
 
 using Point = pcl::PointXYZRGB;
 
@@ -53,21 +54,27 @@ main(int argc, char** argv)
     const dynvo::RigidMotionSegmentationParameters defaults;
     const long hardware_threads = std::max(1U, std::thread::hardware_concurrency());
     std::vector<dynvo::app::Option> options = dynvo::app::frameSourceOptions();
-    options.insert(options.end(),
+    options.insert(
+        options.end(),
         {{"out_dir", "DIR", "folder for <rgb timestamp>.png label images (required)"},
-         {"no_tracking", "", "write the two-frame segments (ids per frame) instead of tracked ids"},
+         {"no_tracking", "",
+          "write the two-frame segments (ids per frame) instead of tracked ids"},
          {"max_frames", "N", "stop after N frames (default: all)"},
-         {"objects", "FILE", "write 'timestamp id n_pixels tx ty tz qx qy qz qw' per object"},
-         {"threads", "N", "worker threads (default: hardware count, " +
-                               std::to_string(hardware_threads) + ")"},
-         {"seed", "S", "hypothesis sampling seed (default " + std::to_string(defaults.seed) + ")"},
+         {"objects", "FILE",
+          "write 'timestamp id n_pixels tx ty tz qx qy qz qw' per object"},
+         {"threads", "N",
+          "worker threads (default: hardware count, " +
+              std::to_string(hardware_threads) + ")"},
+         {"seed", "S",
+          "hypothesis sampling seed (default " + std::to_string(defaults.seed) + ")"},
          {"v", "", "verbose (PCL debug messages)"},
          {"q", "", "quiet (errors only)"}});
     const dynvo::app::Arguments args(argc, argv, options, 0);
     if (args.helpRequested()) {
-      std::printf("Usage: %s\n\nLabels every frame by rigid motion: 0 no measurement, 1 static "
-                  "background, 2.. moving objects.\nFrame 0 has no flow and is all 0.\n\n%s",
-                  USAGE, args.optionsHelp().c_str());
+      std::printf(
+          "Usage: %s\n\nLabels every frame by rigid motion: 0 no measurement, 1 static "
+          "background, 2.. moving objects.\nFrame 0 has no flow and is all 0.\n\n%s",
+          USAGE, args.optionsHelp().c_str());
       return 0;
     }
     if (args.has("v"))
@@ -79,10 +86,13 @@ main(int argc, char** argv)
     const long max_frames = args.integer("max_frames", -1);
     const long threads = args.integer("threads", hardware_threads);
     const long seed = args.integer("seed", defaults.seed);
-    if (threads < 1 || seed < 0 || seed > 4294967295L || max_frames == 0 || max_frames < -1)
-      throw dynvo::app::UsageError("-threads must be >= 1, -seed in [0, 2^32), -max_frames >= 1");
+    if (threads < 1 || seed < 0 || seed > 4294967295L || max_frames == 0 ||
+        max_frames < -1)
+      throw dynvo::app::UsageError(
+          "-threads must be >= 1, -seed in [0, 2^32), -max_frames >= 1");
 
-    const dynvo::CameraIntrinsics intrinsics = dynvo::app::intrinsicsFromArguments(args);
+    const dynvo::CameraIntrinsics intrinsics =
+        dynvo::app::intrinsicsFromArguments(args);
     const dynvo::FrameSource::Ptr source = dynvo::app::openFrameSource(args);
     const std::filesystem::path out_dir = args.string("out_dir");
     std::filesystem::create_directories(out_dir);
@@ -138,10 +148,11 @@ main(int argc, char** argv)
         if (q.w() < 0.0f)
           q.coeffs() = -q.coeffs();
         char line[256];
-        std::snprintf(line, sizeof(line), "%.6f %d %zu %.6f %.6f %.6f %.6f %.6f %.6f %.6f\n",
+        std::snprintf(line, sizeof(line),
+                      "%.6f %d %zu %.6f %.6f %.6f %.6f %.6f %.6f %.6f\n",
                       frame.timestamp, segmentation.getSegmentLabels()[s],
-                      segments[s].indices.size(), T(0, 3), T(1, 3), T(2, 3), q.x(), q.y(),
-                      q.z(), q.w());
+                      segments[s].indices.size(), T(0, 3), T(1, 3), T(2, 3), q.x(),
+                      q.y(), q.z(), q.w());
         objects << line;
       }
     }

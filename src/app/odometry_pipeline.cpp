@@ -56,6 +56,8 @@ allValidCells(const pcl::PointCloud<PointFlow>& flow, std::uint32_t image_width)
 
 } // namespace
 
+PipelineOptions::PipelineOptions() { segmentation.inlier_threshold = 6e-5f; }
+
 void
 PipelineOptions::validate() const
 {

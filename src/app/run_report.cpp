@@ -130,7 +130,7 @@ RunReport::add(const FrameResult& result)
 }
 
 void
-RunReport::printSummary() const
+RunReport::printSummary(const std::string& accuracy) const
 {
   if (terminal_)
     std::fprintf(stderr, "\n");
@@ -140,20 +140,20 @@ RunReport::printSummary() const
           : std::accumulate(total_ms_.begin(), total_ms_.end(), 0.0) / total_ms_.size();
   std::printf("stages median_ms: scene_flow=%.2f segmentation=%.2f registration=%.2f\n",
               median(flow_ms_), median(segmentation_ms_), median(registration_ms_));
+  if (!accuracy.empty())
+    std::printf("%s\n", accuracy.c_str());
   std::printf("frames=%zu lost=%zu median_ms=%.2f mean_ms=%.2f fps=%.1f\n", frames_, lost_,
               median(total_ms_), mean, mean > 0.0 ? 1000.0 / mean : 0.0);
 }
 
-void
-RunReport::printAccuracy(const Trajectory& groundtruth, const Trajectory& estimate)
+std::string
+RunReport::accuracy(const Trajectory& groundtruth, const Trajectory& estimate)
 {
   try {
-    std::printf("%s\n", formatMetrics(computeRpe(groundtruth, estimate),
-                                      computeAte(groundtruth, estimate))
-                            .c_str());
+    return formatMetrics(computeRpe(groundtruth, estimate), computeAte(groundtruth, estimate));
   }
   catch (const std::invalid_argument& e) {
-    std::printf("accuracy not available: %s\n", e.what());
+    return std::string("accuracy not available: ") + e.what();
   }
 }
 

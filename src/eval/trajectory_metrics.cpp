@@ -118,6 +118,18 @@ computeAte(const Trajectory& groundtruth, const Trajectory& estimate, double max
   return result;
 }
 
+Trajectory
+alignToGroundTruth(const Trajectory& groundtruth, const Trajectory& estimate)
+{
+  Trajectory aligned = estimate;
+  if (associateTimestamps(stampsOf(estimate), stampsOf(groundtruth), 0.02).size() < 3)
+    return aligned;
+  const Eigen::Isometry3d T = computeAte(groundtruth, estimate).T_groundtruth_estimate;
+  for (auto& pose : aligned)
+    pose.T_world_camera = T * pose.T_world_camera;
+  return aligned;
+}
+
 std::string
 formatMetrics(const RpeResult& rpe, const AteResult& ate, bool json)
 {

@@ -98,10 +98,10 @@ makeScenarios()
                     ellipse(V(0.4, 0.0, 0.0), V(0.0, 0.3, 0.0), 1.1, 1.0), 0.0)}});
 
   scenarios.push_back(
-      {"moving_crossing", "moving camera, a box crossing the view back and forth",
+      {"moving_crossing", "moving camera, a box entering from the left and crossing back and forth",
        movingCamera(1.0),
        {ellipticBox(1, V(0.3, 0.3, 0.3), V(0.0, 0.0, 1.35),
-                    ellipse(V(1.2, 0.0, 0.0), V(0.0, 0.0, 0.2), 0.55, 0.0), 0.5)}});
+                    ellipse(V(1.2, 0.0, 0.0), V(0.0, 0.0, 0.2), 0.55, -HALF_PI), 0.5)}});
 
   // The box travels along the mean optical axis from 1.8 m to 0.7 m (front face at
   // about 0.35 m, covering most of the image) and back, every 10.5 s.

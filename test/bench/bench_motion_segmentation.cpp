@@ -103,7 +103,40 @@ BENCHMARK(BM_RigidMotionSegmentation)
     ->ArgNames({"noise", "tracking", "threads"})
     ->Args({0, 0, 1})
     ->Args({1, 0, 1})
+    ->Args({0, 1, 1})
+    ->Args({1, 1, 1})
     ->Args({0, 0, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+/// §4-§6 alone: matching, guard, compensation, model update and read-out (the two-frame
+/// segmentations are computed beforehand). Arg: noise.
+void
+BM_SegmentTracking(benchmark::State& state)
+{
+  const std::vector<FlowFrame>& frames = sequence(state.range(0) == 1);
+  const dynvo::RigidMotionSegmentationParameters params;
+  const dynvo::CameraIntrinsics intrinsics;
+  std::vector<dynvo::GridFlowData> grids(frames.size());
+  std::vector<dynvo::SpatialSegmentationResult> spatial(frames.size());
+  dynvo::SpatialSegmenter segmenter;
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    grids[k].assign(*frames[k].flow, params.cell_size);
+    segmenter.segment(grids[k], params, spatial[k]);
+  }
+  dynvo::SegmentTracker tracker;
+  std::size_t k = 0;
+  for (auto _ : state) {
+    const std::size_t f = k++ % frames.size();
+    tracker.update(grids[f], spatial[f], Eigen::Matrix4d::Identity(), intrinsics,
+                   params);
+    benchmark::DoNotOptimize(tracker.labels().data());
+  }
+}
+BENCHMARK(BM_SegmentTracking)
+    ->ArgName("noise")
+    ->Arg(0)
+    ->Arg(1)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

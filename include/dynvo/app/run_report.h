@@ -71,14 +71,14 @@ public:
     return frames_;
   }
 
-  /// Prints the per-stage medians and
+  /// Prints the per-stage medians, then `accuracy` when not empty, and last
   /// "frames=<n> lost=<n> median_ms=<x> mean_ms=<x> fps=<x>" (per frame, decoding excluded).
   void
-  printSummary() const;
+  printSummary(const std::string& accuracy = "") const;
 
-  /// Prints the dynvo_evaluate line of the estimate against the ground truth.
-  static void
-  printAccuracy(const Trajectory& groundtruth, const Trajectory& estimate);
+  /// The dynvo_evaluate line of the estimate against the ground truth (or why there is none).
+  static std::string
+  accuracy(const Trajectory& groundtruth, const Trajectory& estimate);
 
 private:
   std::size_t expected_frames_;

@@ -63,6 +63,12 @@ computeAte(const Trajectory& groundtruth,
            const Trajectory& estimate,
            double max_difference = 0.02);
 
+/** \brief The estimate moved into the ground truth's world frame by the ATE alignment
+ * (for plotting both together); unchanged when fewer than 3 stamps associate.
+ */
+DYNVO_EXPORTS Trajectory
+alignToGroundTruth(const Trajectory& groundtruth, const Trajectory& estimate);
+
 /** \brief The result line of dynvo_evaluate:
  * "rpe_trans_rmse=<m/s> rpe_trans_mean=<m/s> rpe_rot_rmse=<deg/s> ate_rmse=<m> pairs=<n>",
  * or the same fields as one JSON object; no trailing newline.

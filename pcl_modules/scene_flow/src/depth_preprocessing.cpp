@@ -40,7 +40,8 @@ void
 DepthPreprocessing::Parameters::validate() const
 {
   const auto fail = [](const std::string& what) {
-    throw std::invalid_argument("[dynvo::DepthPreprocessing::Parameters::validate] " + what);
+    throw std::invalid_argument("[dynvo::DepthPreprocessing::Parameters::validate] " +
+                                what);
   };
   if (!(std::isfinite(min_depth) && std::isfinite(max_depth) && min_depth > 0.0f &&
         max_depth > min_depth))
@@ -72,8 +73,8 @@ void
 DepthPreprocessing::setNumberOfThreads(unsigned threads)
 {
   if (threads == 0)
-    throw std::invalid_argument(
-        "[dynvo::DepthPreprocessing::setNumberOfThreads] need at least 1 thread, got 0");
+    throw std::invalid_argument("[dynvo::DepthPreprocessing::setNumberOfThreads] need "
+                                "at least 1 thread, got 0");
   threads_ = threads;
 }
 
@@ -100,11 +101,16 @@ DepthPreprocessing::apply(const std::vector<float>& depth,
   const float z_min = params_.min_depth;
   const float z_max = params_.max_depth;
   const float tau_fly = params_.flying_pixel_tolerance;
-  const auto in_range = [z_min, z_max](float q) { return (q >= z_min) & (q <= z_max); };
+  const auto in_range = [z_min, z_max](float q) {
+    return (q >= z_min) & (q <= z_max);
+  };
   // Depth kept at pixel (x, y) given its neighbours n[0..count) (branch-free for vectorising).
+  // Reciprocals, so that the per-pixel bounds cost multiplications rather than divisions.
+  const float lo_factor = 1.0f / (1.0f + tau_fly);
+  const float hi_factor = 1.0f / (1.0f - tau_fly);
   const auto keep = [&](float z, const float* n, int count) {
-    const float lo = z / (1.0f + tau_fly);
-    const float hi = z / (1.0f - tau_fly);
+    const float lo = z * lo_factor;
+    const float hi = z * hi_factor;
     int valid = 0, below = 0, above = 0;
     for (int j = 0; j < count; ++j) {
       const int ok = in_range(n[j]);
@@ -141,8 +147,8 @@ DepthPreprocessing::apply(const std::vector<float>& depth,
       const float* down = mid + w;
       float* dst = out.data() + y * w;
       for (std::size_t x = 1; x + 1 < w; ++x) {
-        const float n[8] = {up[x - 1],  up[x],       up[x + 1],   mid[x - 1],
-                            mid[x + 1], down[x - 1], down[x],     down[x + 1]};
+        const float n[8] = {up[x - 1],  up[x],       up[x + 1], mid[x - 1],
+                            mid[x + 1], down[x - 1], down[x],   down[x + 1]};
         dst[x] = keep(mid[x], n, 8);
       }
       border_pixel(w - 1, y);

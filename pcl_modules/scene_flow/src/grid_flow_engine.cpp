@@ -98,7 +98,8 @@ trackedDepth(const std::vector<float>& depth, int width, cv::Point2f p, float ta
     const float lo = std::min(std::min(z00, z10), std::min(z01, z11));
     const float hi = std::max(std::max(z00, z10), std::max(z01, z11));
     if (hi - lo <= tau_edge * lo)
-      return (1.0f - fy) * ((1.0f - fx) * z00 + fx * z10) + fy * ((1.0f - fx) * z01 + fx * z11);
+      return (1.0f - fy) * ((1.0f - fx) * z00 + fx * z10) +
+             fy * ((1.0f - fx) * z01 + fx * z11);
   }
   // Nearest of the four pixels: it may be valid even when the window straddles an edge.
   const float* row = fy < 0.5f ? row0 : row1;
@@ -110,14 +111,17 @@ trackedDepth(const std::vector<float>& depth, int width, cv::Point2f p, float ta
 struct GridFlowEngine::Frame {
   std::uint32_t width = 0;
   std::uint32_t height = 0;
-  std::vector<cv::Mat> pyramid; ///< cv::buildOpticalFlowPyramid output, with derivatives
-  std::vector<float> depth;     ///< preprocessed (metres, NaN = invalid)
+  std::vector<cv::Mat>
+      pyramid;              ///< cv::buildOpticalFlowPyramid output, with derivatives
+  std::vector<float> depth; ///< preprocessed (metres, NaN = invalid)
   DepthPreprocessing preprocessing;
 };
 
 GridFlowEngine::GridFlowEngine()
-: current_(std::make_unique<Frame>()), previous_(std::make_unique<Frame>())
-{}
+    : current_(std::make_unique<Frame>())
+    , previous_(std::make_unique<Frame>())
+{
+}
 
 GridFlowEngine::~GridFlowEngine() = default;
 
@@ -186,16 +190,17 @@ GridFlowEngine::compute(const GridSceneFlowParameters& params,
   const cv::Size window(params.window_size, params.window_size);
   const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
                                   params.max_iterations, params.epsilon);
-  const float fb2 = params.forward_backward_threshold * params.forward_backward_threshold;
+  const float fb2 =
+      params.forward_backward_threshold * params.forward_backward_threshold;
   const unsigned stripes = static_cast<unsigned>(std::min<std::size_t>(threads, n));
   runStripes(stripes, [&](unsigned s) {
     const auto [begin, end] = stripeRange(n, stripes, s);
     const std::vector<cv::Point2f> from(centres.begin() + begin, centres.begin() + end);
     std::vector<cv::Point2f> to;
     std::vector<std::uint8_t> status;
-    cv::calcOpticalFlowPyrLK(curr.pyramid, prev.pyramid, from, to, status, cv::noArray(),
-                             window, params.max_pyramid_level, criteria, 0,
-                             params.min_eigen_threshold);
+    cv::calcOpticalFlowPyrLK(curr.pyramid, prev.pyramid, from, to, status,
+                             cv::noArray(), window, params.max_pyramid_level, criteria,
+                             0, params.min_eigen_threshold);
     std::vector<cv::Point2f> forward;
     std::vector<std::size_t> index;
     for (std::size_t k = 0; k < from.size(); ++k) {
@@ -213,15 +218,15 @@ GridFlowEngine::compute(const GridSceneFlowParameters& params,
     std::vector<cv::Point2f> back;
     if (params.forward_backward_check == ForwardBackwardCheck::full) {
       cv::calcOpticalFlowPyrLK(prev.pyramid, curr.pyramid, forward, back, status,
-                               cv::noArray(), window, params.max_pyramid_level, criteria, 0,
-                               params.min_eigen_threshold);
+                               cv::noArray(), window, params.max_pyramid_level,
+                               criteria, 0, params.min_eigen_threshold);
     }
     else {
       for (const std::size_t i : index)
         back.push_back(centres[i]);
-      cv::calcOpticalFlowPyrLK(prev.pyramid, curr.pyramid, forward, back, status,
-                               cv::noArray(), window, 0, criteria,
-                               cv::OPTFLOW_USE_INITIAL_FLOW, params.min_eigen_threshold);
+      cv::calcOpticalFlowPyrLK(
+          prev.pyramid, curr.pyramid, forward, back, status, cv::noArray(), window, 0,
+          criteria, cv::OPTFLOW_USE_INITIAL_FLOW, params.min_eigen_threshold);
     }
     for (std::size_t k = 0; k < forward.size(); ++k) {
       const cv::Point2f d = back[k] - centres[index[k]];

@@ -16,31 +16,24 @@ constexpr float NaN = std::numeric_limits<float>::quiet_NaN();
 class DepthPreprocessingTest : public ::testing::Test {
 protected:
   /// w x h map at a constant depth (metres).
-  void
-  flat(std::uint32_t w, std::uint32_t h, float z)
+  void flat(std::uint32_t w, std::uint32_t h, float z)
   {
     width_ = w;
     height_ = h;
     depth_.assign(static_cast<std::size_t>(w) * h, z);
   }
 
-  float&
-  at(std::uint32_t x, std::uint32_t y)
+  float& at(std::uint32_t x, std::uint32_t y)
   {
     return depth_[static_cast<std::size_t>(y) * width_ + x];
   }
 
-  float
-  out(std::uint32_t x, std::uint32_t y) const
+  float out(std::uint32_t x, std::uint32_t y) const
   {
     return out_[static_cast<std::size_t>(y) * width_ + x];
   }
 
-  void
-  run()
-  {
-    preprocessing_.apply(depth_, width_, height_, out_);
-  }
+  void run() { preprocessing_.apply(depth_, width_, height_, out_); }
 
   dynvo::DepthPreprocessing preprocessing_;
   std::uint32_t width_ = 0, height_ = 0;
@@ -63,14 +56,16 @@ TEST_F(DepthPreprocessingTest, RangeLimitsMakeMissingAndOutOfRangeDepthsNaN)
   EXPECT_EQ(out(0, 0), 1.0f);
 }
 
-TEST_F(DepthPreprocessingTest, IsolatedFlyingPixelIsRemovedButSmallDeviationsAndEdgesStay)
+TEST_F(DepthPreprocessingTest,
+       IsolatedFlyingPixelIsRemovedButSmallDeviationsAndEdgesStay)
 {
   flat(20, 10, 1.0f);
   at(4, 4) = 1.5f;   // 50% off its neighbours' median: flying
   at(10, 4) = 1.04f; // 4% off: within tau_fly = 5%
   for (std::uint32_t y = 0; y < 10; ++y)
     for (std::uint32_t x = 15; x < 20; ++x)
-      at(x, y) = 2.0f; // a clean step edge: each side's pixels have a majority on their side
+      at(x, y) =
+          2.0f; // a clean step edge: each side's pixels have a majority on their side
   preprocessing_.setParameters({0.3f, 5.0f, 0.05f, 0, 0.05f}); // no hole filling
   run();
   EXPECT_TRUE(std::isnan(out(4, 4)));
@@ -119,7 +114,8 @@ TEST_F(DepthPreprocessingTest, NarrowRowHoleIsInterpolatedWideOrDiscontinuousHol
 TEST_F(DepthPreprocessingTest, ColumnPassFillsHolesThatNoRowCanBridge)
 {
   flat(10, 12, 1.0f);
-  for (std::uint32_t y = 4; y < 7; ++y) // three whole rows missing: no row has valid ends
+  for (std::uint32_t y = 4; y < 7;
+       ++y) // three whole rows missing: no row has valid ends
     for (std::uint32_t x = 0; x < 10; ++x)
       at(x, y) = NaN;
   run();
@@ -143,7 +139,8 @@ TEST_F(DepthPreprocessingTest, ResultDoesNotDependOnThreadCount)
     run();
     ASSERT_EQ(out_.size(), single.size());
     for (std::size_t i = 0; i < single.size(); ++i)
-      ASSERT_TRUE(out_[i] == single[i] || (std::isnan(out_[i]) && std::isnan(single[i])))
+      ASSERT_TRUE(out_[i] == single[i] ||
+                  (std::isnan(out_[i]) && std::isnan(single[i])))
           << "pixel " << i << " with " << threads << " threads";
   }
 }

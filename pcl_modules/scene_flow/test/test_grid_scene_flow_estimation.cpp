@@ -12,6 +12,7 @@
 #include <cstring>
 #include <limits>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace {
@@ -91,7 +92,8 @@ expectCellContract(const FlowCloud& flow)
       EXPECT_TRUE(std::isfinite(f.prev_z) && std::isfinite(f.z));
       EXPECT_GT(f.weight, 0.0f);
       EXPECT_LE(f.weight, 1.0f);
-    } else {
+    }
+    else {
       EXPECT_EQ(f.weight, 0.0f);
       EXPECT_TRUE(std::isnan(f.prev_x) && std::isnan(f.prev_y) && std::isnan(f.prev_z));
     }
@@ -105,11 +107,11 @@ bool
 identical(const FlowCloud& a, const FlowCloud& b)
 {
   return a.width == b.width && a.height == b.height &&
-         std::memcmp(a.points.data(), b.points.data(), a.size() * sizeof(PointFlow)) == 0;
+         std::memcmp(a.points.data(), b.points.data(), a.size() * sizeof(PointFlow)) ==
+             0;
 }
 
-template <typename PointT>
-class GridSceneFlowTest : public ::testing::Test {
+template <typename PointT> class GridSceneFlowTest : public ::testing::Test {
 protected:
   using Cloud = pcl::PointCloud<PointT>;
   static constexpr std::uint32_t WIDTH = 160;
@@ -117,14 +119,15 @@ protected:
 
   GridSceneFlowTest() { estimation_.setCameraIntrinsics(intrinsics_); }
 
-  dynvo::test::RenderedView<PointT>
-  view(const std::vector<TexturedQuad>& quads, const Eigen::Isometry3d& T_world_camera) const
+  dynvo::test::RenderedView<PointT> view(const std::vector<TexturedQuad>& quads,
+                                         const Eigen::Isometry3d& T_world_camera) const
   {
-    return dynvo::test::render<PointT>(quads, T_world_camera, intrinsics_, WIDTH, HEIGHT);
+    return dynvo::test::render<PointT>(quads, T_world_camera, intrinsics_, WIDTH,
+                                       HEIGHT);
   }
 
-  void
-  run(const typename Cloud::ConstPtr& previous, const typename Cloud::ConstPtr& current)
+  void run(const typename Cloud::ConstPtr& previous,
+           const typename Cloud::ConstPtr& current)
   {
     estimation_.setPreviousCloud(previous);
     estimation_.setInputCloud(current);
@@ -157,33 +160,51 @@ TYPED_TEST(GridSceneFlowTest, SameFrameTwiceGivesZeroFlowOnEveryTexturedCell)
   }
 }
 
-TYPED_TEST(GridSceneFlowTest, KnownCameraMotionIsRecoveredOnEveryStaticCell)
+TYPED_TEST(GridSceneFlowTest, KnownCameraMotionIsRecoveredForwardAndInverse)
 {
   const auto scene = staticRoom();
-  // Previous camera = world; the current one moved by ~2.6 cm and ~1.1 deg (3-5 px of flow).
-  const Eigen::Isometry3d T_world_curr = pose(0.5, 1.0, 0.3, 0.02, -0.01, 0.015);
-  const auto previous = this->view(scene, Eigen::Isometry3d::Identity());
-  const auto current = this->view(scene, T_world_curr);
-  this->run(previous.cloud, current.cloud);
-  expectCellContract(this->flow_);
-  std::vector<double> error_3d, error_2d;
-  for (const PointFlow& f : this->flow_) {
-    if (!f.valid_3d)
-      continue;
-    // b_i is exact (noise-free depth at an integer pixel): its true previous position is known.
-    const Eigen::Vector3d a_true = T_world_curr * currPoint(f);
-    const Eigen::Vector2f p_true = this->intrinsics_.project(a_true.cast<float>());
-    error_3d.push_back((prevPoint(f) - a_true).norm());
-    error_2d.push_back((Eigen::Vector2f(f.prev_u, f.prev_v) - p_true).norm());
+  // The camera moves by ~2.6 cm and ~1.1 deg between the poses: 3-5 px of flow.
+  const Eigen::Isometry3d T_world_a = Eigen::Isometry3d::Identity();
+  const Eigen::Isometry3d T_world_b = pose(0.5, 1.0, 0.3, 0.02, -0.01, 0.015);
+  const auto view_a = this->view(scene, T_world_a);
+  const auto view_b = this->view(scene, T_world_b);
+  for (const auto check :
+       {dynvo::ForwardBackwardCheck::local, dynvo::ForwardBackwardCheck::full}) {
+    this->estimation_.setForwardBackwardCheck(check);
+    for (const bool inverse : {false, true}) {
+      SCOPED_TRACE(std::string(inverse ? "b -> a" : "a -> b") +
+                   (check == dynvo::ForwardBackwardCheck::full ? ", full check"
+                                                               : ", local check"));
+      const Eigen::Isometry3d T_prev_curr =
+          inverse ? T_world_b.inverse() * T_world_a : T_world_a.inverse() * T_world_b;
+      this->run(inverse ? view_b.cloud : view_a.cloud,
+                inverse ? view_a.cloud : view_b.cloud);
+      expectCellContract(this->flow_);
+      std::vector<double> error_3d, error_2d;
+      for (const PointFlow& f : this->flow_) {
+        if (!f.valid_3d)
+          continue;
+        // b_i is exact (noise-free depth at an integer pixel): its true previous position is known.
+        const Eigen::Vector3d a_true = T_prev_curr * currPoint(f);
+        const Eigen::Vector2f p_true = this->intrinsics_.project(a_true.cast<float>());
+        error_3d.push_back((prevPoint(f) - a_true).norm());
+        error_2d.push_back((Eigen::Vector2f(f.prev_u, f.prev_v) - p_true).norm());
+      }
+      // Cells whose window leaves the image or straddles the board's outline may be rejected.
+      ASSERT_GE(error_3d.size(), this->flow_.size() * 8 / 10);
+      const std::string key =
+          std::string(inverse ? "inverse_" : "forward_") +
+          (check == dynvo::ForwardBackwardCheck::full ? "full_" : "local_");
+      this->RecordProperty(key + "median_error_2d_px",
+                           std::to_string(median(error_2d)));
+      this->RecordProperty(key + "median_error_3d_mm",
+                           std::to_string(median(error_3d) * 1000.0));
+      // 0.2 px at 1.2-2 m and fx = 131 px is 2-3 mm laterally; 5 mm leaves room for the
+      // bilinear depth on the slanted board.
+      EXPECT_LT(median(error_2d), 0.2);
+      EXPECT_LT(median(error_3d), 0.005);
+    }
   }
-  // Cells whose window leaves the image or straddles the board's outline may be rejected.
-  ASSERT_GE(error_3d.size(), this->flow_.size() * 8 / 10);
-  // 0.2 px at 1.2-2 m and fx = 131 px is 2-3 mm laterally; 5 mm leaves room for the
-  // bilinear depth on the slanted board.
-  this->RecordProperty("median_error_2d_px", std::to_string(median(error_2d)));
-  this->RecordProperty("median_error_3d_mm", std::to_string(median(error_3d) * 1000.0));
-  EXPECT_LT(median(error_2d), 0.2);
-  EXPECT_LT(median(error_3d), 0.005);
 }
 
 TYPED_TEST(GridSceneFlowTest, MovingObjectCellsCarryTheObjectMotion)
@@ -226,7 +247,8 @@ TYPED_TEST(GridSceneFlowTest, MovingObjectCellsCarryTheObjectMotion)
       EXPECT_TRUE(std::isnan(f.z));
       continue;
     }
-    const auto pixel = static_cast<std::size_t>(f.v) * this->WIDTH + static_cast<std::size_t>(f.u);
+    const auto pixel =
+        static_cast<std::size_t>(f.v) * this->WIDTH + static_cast<std::size_t>(f.u);
     if (current.ids[pixel] != 1)
       continue;
     ++object_cells;
@@ -239,8 +261,10 @@ TYPED_TEST(GridSceneFlowTest, MovingObjectCellsCarryTheObjectMotion)
   ASSERT_GE(object_cells, 8u); // the box spans ~4x3 cells at this size
   // Cells near the outline see both motions and may be rejected; most must survive.
   ASSERT_GE(object_error.size() * 2, object_cells);
-  this->RecordProperty("object_median_error_3d_mm", std::to_string(median(object_error) * 1000.0));
-  EXPECT_LT(median(object_error), 0.005); // as for camera motion; the object moves 4-5 cm
+  this->RecordProperty("object_median_error_3d_mm",
+                       std::to_string(median(object_error) * 1000.0));
+  EXPECT_LT(median(object_error),
+            0.005); // as for camera motion; the object moves 4-5 cm
 }
 
 TYPED_TEST(GridSceneFlowTest, ShiftCurrentToPreviousMatchesAFreshComputation)
@@ -292,8 +316,7 @@ protected:
   using Cloud = pcl::PointCloud<pcl::PointXYZRGB>;
 
   /// Runs compute() on an output holding stale content; returns what PCL_ERROR printed.
-  std::string
-  computeCapturingErrors()
+  std::string computeCapturingErrors()
   {
     flow_.resize(3, 1);
     ::testing::internal::CaptureStderr();
@@ -301,10 +324,10 @@ protected:
     return ::testing::internal::GetCapturedStderr();
   }
 
-  static Cloud::Ptr
-  organized(std::uint32_t width, std::uint32_t height)
+  static Cloud::Ptr organized(std::uint32_t width, std::uint32_t height)
   {
-    return dynvo::test::render<pcl::PointXYZRGB>(staticRoom(), Eigen::Isometry3d::Identity(),
+    return dynvo::test::render<pcl::PointXYZRGB>(staticRoom(),
+                                                 Eigen::Isometry3d::Identity(),
                                                  scaledIntrinsics(width), width, height)
         .cloud;
   }
@@ -323,7 +346,8 @@ TEST_F(GridSceneFlowContractTest, MissingInputsGiveClearedOutputAndAnError)
   EXPECT_TRUE(flow_.empty());
 }
 
-TEST_F(GridSceneFlowContractTest, UnorganizedMismatchedOrTooSmallInputsGiveClearedOutput)
+TEST_F(GridSceneFlowContractTest,
+       UnorganizedMismatchedOrTooSmallInputsGiveClearedOutput)
 {
   const Cloud::Ptr frame = organized(32, 32);
   Cloud::Ptr unorganized(new Cloud(*frame));
@@ -348,10 +372,10 @@ TEST_F(GridSceneFlowContractTest, UnorganizedMismatchedOrTooSmallInputsGiveClear
 TEST_F(GridSceneFlowContractTest, VgaPairGivesAFortyByThirtyGridOnCellCentres)
 {
   const Cloud::Ptr previous = organized(640, 480);
-  const Cloud::Ptr current = dynvo::test::render<pcl::PointXYZRGB>(
-                                 staticRoom(), pose(0, 0.5, 0, 0.01, 0, 0),
-                                 scaledIntrinsics(640), 640, 480)
-                                 .cloud;
+  const Cloud::Ptr current =
+      dynvo::test::render<pcl::PointXYZRGB>(staticRoom(), pose(0, 0.5, 0, 0.01, 0, 0),
+                                            scaledIntrinsics(640), 640, 480)
+          .cloud;
   current->header.stamp = 42;
   estimation_.setCameraIntrinsics(scaledIntrinsics(640));
   estimation_.setPreviousCloud(previous);
@@ -367,8 +391,9 @@ TEST_F(GridSceneFlowContractTest, VgaPairGivesAFortyByThirtyGridOnCellCentres)
       EXPECT_EQ(flow_(col, row).v, 16.0f * row + 8.0f);
     }
   expectCellContract(flow_);
-  const auto valid = std::count_if(flow_.begin(), flow_.end(),
-                                   [](const PointFlow& f) { return f.valid_3d != 0; });
+  const auto valid = std::count_if(flow_.begin(), flow_.end(), [](const PointFlow& f) {
+    return f.valid_3d != 0;
+  });
   EXPECT_GE(valid, 1100); // textured scene, small motion: only border cells may fail
 }
 

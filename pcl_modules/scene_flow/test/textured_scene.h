@@ -29,20 +29,24 @@ valueNoise(double s, double t, std::uint32_t seed)
   };
   const double fs = std::floor(s), ft = std::floor(t);
   const auto i = static_cast<std::int64_t>(fs), j = static_cast<std::int64_t>(ft);
-  const auto smooth = [](double x) { return static_cast<float>(x * x * (3.0 - 2.0 * x)); };
+  const auto smooth = [](double x) {
+    return static_cast<float>(x * x * (3.0 - 2.0 * x));
+  };
   const float a = smooth(s - fs), b = smooth(t - ft);
   const float top = lattice(i, j) + a * (lattice(i + 1, j) - lattice(i, j));
-  const float bottom = lattice(i, j + 1) + a * (lattice(i + 1, j + 1) - lattice(i, j + 1));
+  const float bottom =
+      lattice(i, j + 1) + a * (lattice(i + 1, j + 1) - lattice(i, j + 1));
   return top + b * (bottom - top);
 }
 
 /// A textured rectangle: z = 0 and |x| <= half_width, |y| <= half_height in its own frame.
 struct TexturedQuad {
-  Eigen::Isometry3d T_world_quad = Eigen::Isometry3d::Identity(); ///< quad-to-world (metres)
-  double half_width = 1.0;  ///< metres
-  double half_height = 1.0; ///< metres
-  std::uint32_t seed = 0;   ///< texture seed
-  int id = 0;               ///< reported per pixel by render()
+  Eigen::Isometry3d T_world_quad =
+      Eigen::Isometry3d::Identity(); ///< quad-to-world (metres)
+  double half_width = 1.0;           ///< metres
+  double half_height = 1.0;          ///< metres
+  std::uint32_t seed = 0;            ///< texture seed
+  int id = 0;                        ///< reported per pixel by render()
 };
 
 /// Grey level of the texture at quad coordinates (metres): features of 5-10 cm.
@@ -55,8 +59,7 @@ textureGrey(const TexturedQuad& quad, double x, double y)
 }
 
 /// One rendered view: organized cloud plus the id of the quad seen at each pixel (-1 = none).
-template <typename PointT>
-struct RenderedView {
+template <typename PointT> struct RenderedView {
   typename pcl::PointCloud<PointT>::Ptr cloud;
   std::vector<int> ids;
 };
@@ -113,9 +116,8 @@ render(const std::vector<TexturedQuad>& quads,
       const double z = cast(u, v, id, st);
       view.ids[static_cast<std::size_t>(v) * width + u] = id;
       if (id >= 0)
-        p.getVector3fMap() = intrinsics.backproject(static_cast<float>(u),
-                                                    static_cast<float>(v),
-                                                    static_cast<float>(z));
+        p.getVector3fMap() = intrinsics.backproject(
+            static_cast<float>(u), static_cast<float>(v), static_cast<float>(z));
       else
         p.x = p.y = p.z = std::numeric_limits<float>::quiet_NaN();
       int sum = 0;

@@ -31,15 +31,17 @@ class DYNVO_EXPORTS DepthPreprocessing {
 public:
   /// Knobs of ALGORITHM.md §1.1 / §9.
   struct Parameters {
-    float min_depth = 0.3f;               ///< z_min (metres): nearer depths are invalid
-    float max_depth = 5.0f;               ///< z_max (metres): farther depths are invalid
-    float flying_pixel_tolerance = 0.05f; ///< tau_fly (relative, in (0, 1)): allowed deviation from the 3x3 median
-    int max_hole_width = 5;               ///< w_hole (px, >= 0; 0 disables filling): longest run that is filled
-    float hole_fill_tolerance = 0.05f;    ///< tau_fill (relative, >= 0): allowed |zL - zR| / min(zL, zR)
+    float min_depth = 0.3f; ///< z_min (metres): nearer depths are invalid
+    float max_depth = 5.0f; ///< z_max (metres): farther depths are invalid
+    /// tau_fly (relative, in (0, 1)): allowed deviation from the 3x3 median.
+    float flying_pixel_tolerance = 0.05f;
+    /// w_hole (px, >= 0; 0 disables filling): longest run of NaN that is filled.
+    int max_hole_width = 5;
+    /// tau_fill (relative, >= 0): largest |zL - zR| / min(zL, zR) that is filled.
+    float hole_fill_tolerance = 0.05f;
 
     /// \throws std::invalid_argument when a value is out of the range stated above
-    void
-    validate() const;
+    void validate() const;
   };
 
   DepthPreprocessing() = default;
@@ -48,26 +50,16 @@ public:
   explicit DepthPreprocessing(const Parameters& parameters);
 
   /// \throws std::invalid_argument when parameters.validate() fails
-  void
-  setParameters(const Parameters& parameters);
+  void setParameters(const Parameters& parameters);
 
-  const Parameters&
-  getParameters() const
-  {
-    return params_;
-  }
+  const Parameters& getParameters() const { return params_; }
 
   /** \brief Threads used by apply() (default 1); the result does not depend on it.
    * \throws std::invalid_argument when threads is 0
    */
-  void
-  setNumberOfThreads(unsigned threads);
+  void setNumberOfThreads(unsigned threads);
 
-  unsigned
-  getNumberOfThreads() const
-  {
-    return threads_;
-  }
+  unsigned getNumberOfThreads() const { return threads_; }
 
   /** \brief Clean one depth map.
    * \param[in] depth width * height depths (metres, row-major), NaN or 0 = no measurement
@@ -77,14 +69,13 @@ public:
    *             alias depth
    * \throws std::invalid_argument when depth.size() != width * height or out aliases depth
    */
-  void
-  apply(const std::vector<float>& depth,
-        std::uint32_t width,
-        std::uint32_t height,
-        std::vector<float>& out) const;
+  void apply(const std::vector<float>& depth,
+             std::uint32_t width,
+             std::uint32_t height,
+             std::vector<float>& out) const;
 
 private:
-  Parameters params_;   ///< validated knobs
+  Parameters params_;    ///< validated knobs
   unsigned threads_ = 1; ///< worker threads (>= 1)
 };
 

@@ -28,8 +28,7 @@ public:
   GridFlowEngine();
   ~GridFlowEngine();
   GridFlowEngine(const GridFlowEngine&) = delete;
-  GridFlowEngine&
-  operator=(const GridFlowEngine&) = delete;
+  GridFlowEngine& operator=(const GridFlowEngine&) = delete;
 
   /** \brief Preprocess a frame's depth and build its pyramid into a slot.
    * \param[in] grey width * height grey levels, row-major
@@ -39,32 +38,28 @@ public:
    * \param[in] params validated parameters (depth rules, LK window and levels)
    * \param[in] threads worker threads (>= 1)
    */
-  void
-  prepare(Slot slot,
-          const std::vector<std::uint8_t>& grey,
-          const std::vector<float>& depth,
-          std::uint32_t width,
-          std::uint32_t height,
-          const GridSceneFlowParameters& params,
-          unsigned threads);
+  void prepare(Slot slot,
+               const std::vector<std::uint8_t>& grey,
+               const std::vector<float>& depth,
+               std::uint32_t width,
+               std::uint32_t height,
+               const GridSceneFlowParameters& params,
+               unsigned threads);
 
   /// The current slot becomes the previous one (no copy); the current slot is then stale.
-  void
-  shiftCurrentToPrevious();
+  void shiftCurrentToPrevious();
 
   /** \brief Grid scene flow from the previous to the current slot (ALGORITHM.md §1.2).
    * Both slots must have been prepared with the same size and params.
    * \param[out] flow organized (width / cell_size) x (height / cell_size) cloud
    */
-  void
-  compute(const GridSceneFlowParameters& params,
-          const CameraIntrinsics& intrinsics,
-          unsigned threads,
-          pcl::PointCloud<PointFlow>& flow) const;
+  void compute(const GridSceneFlowParameters& params,
+               const CameraIntrinsics& intrinsics,
+               unsigned threads,
+               pcl::PointCloud<PointFlow>& flow) const;
 
   /// Preprocessed depth (metres, NaN = invalid) of a prepared slot, row-major.
-  const std::vector<float>&
-  depth(Slot slot) const;
+  const std::vector<float>& depth(Slot slot) const;
 
 private:
   struct Frame;

@@ -48,8 +48,7 @@ namespace dynvo {
  * Not thread-safe; separate instances may run concurrently. Explicitly instantiated for
  * pcl::PointXYZRGB and pcl::PointXYZRGBA (other types: include the impl .hpp).
  */
-template <typename PointT>
-class GridSceneFlowEstimation : public pcl::PCLBase<PointT> {
+template <typename PointT> class GridSceneFlowEstimation : public pcl::PCLBase<PointT> {
 public:
   using Base = pcl::PCLBase<PointT>;
   using PointCloud = pcl::PointCloud<PointT>;
@@ -63,103 +62,118 @@ public:
   GridSceneFlowEstimation() = default;
 
   /// Name used in log prefixes: "GridSceneFlowEstimation".
-  const std::string&
-  getClassName() const
-  {
-    return class_name_;
-  }
+  const std::string& getClassName() const { return class_name_; }
 
   /// Current frame k (organized, metres, current camera frame); the grid is anchored here.
-  void
-  setInputCloud(const PointCloudConstPtr& cloud) override;
+  void setInputCloud(const PointCloudConstPtr& cloud) override;
 
   /// Previous frame k-1 (organized, same size as the input cloud).
-  void
-  setPreviousCloud(const PointCloudConstPtr& cloud);
+  void setPreviousCloud(const PointCloudConstPtr& cloud);
 
-  const PointCloudConstPtr&
-  getPreviousCloud() const
-  {
-    return previous_;
-  }
+  const PointCloudConstPtr& getPreviousCloud() const { return previous_; }
 
   /** \brief Makes the current frame the previous one, keeping its pyramid and depth map.
    * The input cloud is cleared: set the next frame before calling compute() again.
    */
-  void
-  shiftCurrentToPrevious();
+  void shiftCurrentToPrevious();
 
   /** \brief Computes the grid scene flow from the previous cloud to the input cloud.
    * \param[out] flow organized grid (see the class doc); empty when the inputs break the
    *             contract (null, unorganized, sizes differ, smaller than one cell), which is
    *             logged with PCL_ERROR
    */
-  void
-  compute(FlowCloud& flow);
+  void compute(FlowCloud& flow);
 
   /// \throws std::invalid_argument when intrinsics.validate() fails
-  void
-  setCameraIntrinsics(const CameraIntrinsics& intrinsics);
+  void setCameraIntrinsics(const CameraIntrinsics& intrinsics);
 
-  const CameraIntrinsics&
-  getCameraIntrinsics() const
-  {
-    return intrinsics_;
-  }
+  const CameraIntrinsics& getCameraIntrinsics() const { return intrinsics_; }
 
   /// Worker threads (default 1); results are identical for any count. \throws std::invalid_argument on 0
-  void
-  setNumberOfThreads(unsigned threads);
+  void setNumberOfThreads(unsigned threads);
 
-  unsigned
-  getNumberOfThreads() const
-  {
-    return threads_;
-  }
+  unsigned getNumberOfThreads() const { return threads_; }
 
   /// All knobs at once. \throws std::invalid_argument when parameters.validate() fails
-  void
-  setParameters(const Parameters& parameters);
+  void setParameters(const Parameters& parameters);
 
-  const Parameters&
-  getParameters() const
-  {
-    return params_;
-  }
+  const Parameters& getParameters() const { return params_; }
 
   // One setter/getter pair per field of Parameters; each throws std::invalid_argument on a
   // value out of the range documented in GridSceneFlowParameters.
   void setCellSize(int px) { updateField(&Parameters::cell_size, px); }
   int getCellSize() const { return params_.cell_size; }
-  void setMinDepth(float metres) { updateDepthField(&DepthPreprocessing::Parameters::min_depth, metres); }
+  void setMinDepth(float metres)
+  {
+    updateDepthField(&DepthPreprocessing::Parameters::min_depth, metres);
+  }
   float getMinDepth() const { return params_.depth.min_depth; }
-  void setMaxDepth(float metres) { updateDepthField(&DepthPreprocessing::Parameters::max_depth, metres); }
+  void setMaxDepth(float metres)
+  {
+    updateDepthField(&DepthPreprocessing::Parameters::max_depth, metres);
+  }
   float getMaxDepth() const { return params_.depth.max_depth; }
-  void setFlyingPixelTolerance(float ratio) { updateDepthField(&DepthPreprocessing::Parameters::flying_pixel_tolerance, ratio); }
+  void setFlyingPixelTolerance(float ratio)
+  {
+    updateDepthField(&DepthPreprocessing::Parameters::flying_pixel_tolerance, ratio);
+  }
   float getFlyingPixelTolerance() const { return params_.depth.flying_pixel_tolerance; }
-  void setMaxHoleWidth(int px) { updateDepthField(&DepthPreprocessing::Parameters::max_hole_width, px); }
+  void setMaxHoleWidth(int px)
+  {
+    updateDepthField(&DepthPreprocessing::Parameters::max_hole_width, px);
+  }
   int getMaxHoleWidth() const { return params_.depth.max_hole_width; }
-  void setHoleFillTolerance(float ratio) { updateDepthField(&DepthPreprocessing::Parameters::hole_fill_tolerance, ratio); }
+  void setHoleFillTolerance(float ratio)
+  {
+    updateDepthField(&DepthPreprocessing::Parameters::hole_fill_tolerance, ratio);
+  }
   float getHoleFillTolerance() const { return params_.depth.hole_fill_tolerance; }
   void setWindowSize(int px) { updateField(&Parameters::window_size, px); }
   int getWindowSize() const { return params_.window_size; }
-  void setMaxPyramidLevel(int level) { updateField(&Parameters::max_pyramid_level, level); }
+  void setMaxPyramidLevel(int level)
+  {
+    updateField(&Parameters::max_pyramid_level, level);
+  }
   int getMaxPyramidLevel() const { return params_.max_pyramid_level; }
-  void setMaxIterations(int iterations) { updateField(&Parameters::max_iterations, iterations); }
+  void setMaxIterations(int iterations)
+  {
+    updateField(&Parameters::max_iterations, iterations);
+  }
   int getMaxIterations() const { return params_.max_iterations; }
   void setEpsilon(double px) { updateField(&Parameters::epsilon, px); }
   double getEpsilon() const { return params_.epsilon; }
-  void setMinEigenThreshold(double threshold) { updateField(&Parameters::min_eigen_threshold, threshold); }
+  void setMinEigenThreshold(double threshold)
+  {
+    updateField(&Parameters::min_eigen_threshold, threshold);
+  }
   double getMinEigenThreshold() const { return params_.min_eigen_threshold; }
-  void setForwardBackwardCheck(ForwardBackwardCheck check) { updateField(&Parameters::forward_backward_check, check); }
-  ForwardBackwardCheck getForwardBackwardCheck() const { return params_.forward_backward_check; }
-  void setForwardBackwardThreshold(float px) { updateField(&Parameters::forward_backward_threshold, px); }
-  float getForwardBackwardThreshold() const { return params_.forward_backward_threshold; }
-  void setDepthEdgeTolerance(float ratio) { updateField(&Parameters::depth_edge_tolerance, ratio); }
+  void setForwardBackwardCheck(ForwardBackwardCheck check)
+  {
+    updateField(&Parameters::forward_backward_check, check);
+  }
+  ForwardBackwardCheck getForwardBackwardCheck() const
+  {
+    return params_.forward_backward_check;
+  }
+  void setForwardBackwardThreshold(float px)
+  {
+    updateField(&Parameters::forward_backward_threshold, px);
+  }
+  float getForwardBackwardThreshold() const
+  {
+    return params_.forward_backward_threshold;
+  }
+  void setDepthEdgeTolerance(float ratio)
+  {
+    updateField(&Parameters::depth_edge_tolerance, ratio);
+  }
   float getDepthEdgeTolerance() const { return params_.depth_edge_tolerance; }
   void setMaxFlow(float metres) { updateField(&Parameters::max_flow, metres); }
   float getMaxFlow() const { return params_.max_flow; }
-  void setWeightReferenceDepth(float metres) { updateField(&Parameters::weight_reference_depth, metres); }
+  void setWeightReferenceDepth(float metres)
+  {
+    updateField(&Parameters::weight_reference_depth, metres);
+  }
   float getWeightReferenceDepth() const { return params_.weight_reference_depth; }
 
 protected:
@@ -167,21 +181,16 @@ protected:
   using Base::input_;
 
   /// Non-null, organized inputs of equal size; logs PCL_ERROR and returns false otherwise.
-  bool
-  initCompute();
+  bool initCompute();
 
   /// The image holds at least one grid cell; logs PCL_ERROR and returns false otherwise.
-  bool
-  validateInputs() const;
+  bool validateInputs() const;
 
   /// Converts a cloud to grey levels and depths and prepares it in an engine slot.
-  void
-  prepareFrame(const PointCloud& cloud, detail::GridFlowEngine::Slot slot);
+  void prepareFrame(const PointCloud& cloud, detail::GridFlowEngine::Slot slot);
 
 private:
-  template <typename Field>
-  void
-  updateField(Field Parameters::*field, Field value)
+  template <typename Field> void updateField(Field Parameters::*field, Field value)
   {
     Parameters updated = params_;
     updated.*field = value;
@@ -189,8 +198,7 @@ private:
   }
 
   template <typename Field>
-  void
-  updateDepthField(Field DepthPreprocessing::Parameters::*field, Field value)
+  void updateDepthField(Field DepthPreprocessing::Parameters::*field, Field value)
   {
     Parameters updated = params_;
     updated.depth.*field = value;
@@ -198,15 +206,15 @@ private:
   }
 
   std::string class_name_ = "GridSceneFlowEstimation"; ///< log prefix
-  Parameters params_;                ///< validated knobs
-  CameraIntrinsics intrinsics_;      ///< back-projection (default preset "default")
-  unsigned threads_ = 1;             ///< worker threads
-  PointCloudConstPtr previous_;      ///< frame k-1
-  detail::GridFlowEngine engine_;    ///< pyramids and preprocessed depth of both frames
-  bool current_ready_ = false;       ///< engine current slot matches input_ and params_
-  bool previous_ready_ = false;      ///< engine previous slot matches previous_ and params_
-  std::vector<std::uint8_t> grey_;   ///< conversion buffer (grey levels)
-  std::vector<float> depth_;         ///< conversion buffer (metres)
+  Parameters params_;                                  ///< validated knobs
+  CameraIntrinsics intrinsics_;   ///< back-projection (default preset "default")
+  unsigned threads_ = 1;          ///< worker threads
+  PointCloudConstPtr previous_;   ///< frame k-1
+  detail::GridFlowEngine engine_; ///< pyramids and preprocessed depth of both frames
+  bool current_ready_ = false;    ///< engine current slot matches input_ and params_
+  bool previous_ready_ = false; ///< engine previous slot matches previous_ and params_
+  std::vector<std::uint8_t> grey_; ///< conversion buffer (grey levels)
+  std::vector<float> depth_;       ///< conversion buffer (metres)
 };
 
 } // namespace dynvo

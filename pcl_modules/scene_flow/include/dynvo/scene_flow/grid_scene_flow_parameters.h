@@ -9,35 +9,50 @@ namespace dynvo {
 
 /// How the forward-backward check of ALGORITHM.md §1.2 tracks p_i back into the current image.
 enum class ForwardBackwardCheck {
-  full,  ///< from scratch through the whole pyramid, as ALGORITHM.md §1.2 states (cost x2)
+  full, ///< from scratch through the whole pyramid, as ALGORITHM.md §1.2 states (cost x2)
   local, ///< started at c_i on the finest level only (about a quarter of the forward cost):
-         ///< rejects tracks whose reverse LK does not stay at c_i, not far-away wrong matches
+  ///< rejects tracks whose reverse LK does not stay at c_i, not far-away wrong matches
 };
 
 /** \brief Parameters of GridSceneFlowEstimation (the single source of the defaults).
  *
- * The Lucas-Kanade settings differ from ALGORITHM.md §1.2 (window 21, maxLevel 3, 30 iterations,
- * eps 0.01): those cost about 20 ms per VGA frame with the forward-backward check on one core
- * (PLATFORM.md), against a budget of 8 ms for the whole stage. The defaults below were chosen by
- * measurement on TUM fr1/xyz and synthetic frame pairs (see pcl_modules/scene_flow/NOTES.md).
+ * The Lucas-Kanade defaults differ from ALGORITHM.md §1.2 (window 21, maxLevel 3, 30 iterations,
+ * eps 0.01, backward track from scratch): those cost about 25 ms per VGA frame on one core of
+ * the target machine (PLATFORM.md), against a budget of 8 ms for the whole stage. Window 13,
+ * maxLevel 2, 10 iterations, eps 0.03 and the local check keep the synthetic end-point error at
+ * about 0.1 px (VGA, 15-27 px of flow) and the share of valid cells on TUM fr1/xyz within 3
+ * points of the ALGORITHM.md settings; the measurements are in pcl_modules/scene_flow/NOTES.md.
  */
 struct DYNVO_EXPORTS GridSceneFlowParameters {
-  int cell_size = 16; ///< w_grid (px, >= 2): grid cell size; cell (col, row) is centred on pixel (col, row) * cell_size + cell_size / 2
-  DepthPreprocessing::Parameters depth; ///< z_min, z_max, tau_fly, w_hole, tau_fill (ALGORITHM.md §1.1)
-  int window_size = 15;        ///< LK win (px, >= 3): side of the square LK window
-  int max_pyramid_level = 3;   ///< LK levels (>= 0): OpenCV maxLevel, 0 = no pyramid
-  int max_iterations = 10;     ///< LK iters (>= 1): iteration cap per pyramid level
-  double epsilon = 0.03;       ///< LK eps (px, > 0): stop when an update is shorter
-  double min_eigen_threshold = 1e-4; ///< OpenCV minEigThreshold (> 0): rejects textureless windows
-  ForwardBackwardCheck forward_backward_check = ForwardBackwardCheck::local; ///< backward tracking scheme
-  float forward_backward_threshold = 1.0f; ///< fb_max (px, > 0): largest |c' - c| of the forward-backward check
-  float depth_edge_tolerance = 0.05f; ///< tau_edge (relative, >= 0): bilinear depth needs (max - min) <= tau_edge * min
-  float max_flow = 0.5f;       ///< max_flow3d (metres per frame, > 0): larger |b - a| is a gross error
-  float weight_reference_depth = 1.5f; ///< z_ref (metres, > 0): weight = min(1, (z_ref / z)^4), the inverse of the z^2 depth-noise variance
+  /// w_grid (px, >= 2): cell size; cell (col, row) is centred on pixel
+  /// (col, row) * cell_size + cell_size / 2.
+  int cell_size = 16;
+  /// z_min, z_max, tau_fly, w_hole, tau_fill (ALGORITHM.md §1.1).
+  DepthPreprocessing::Parameters depth;
+  /// LK win (px, >= 3): side of the square LK window (ALGORITHM.md: 21).
+  int window_size = 13;
+  /// LK levels (>= 0): OpenCV maxLevel, 0 = no pyramid (ALGORITHM.md: 3).
+  int max_pyramid_level = 2;
+  /// LK iters (>= 1): iteration cap per pyramid level (ALGORITHM.md: 30).
+  int max_iterations = 10;
+  /// LK eps (px, > 0): stop iterating when an update is shorter (ALGORITHM.md: 0.01).
+  double epsilon = 0.03;
+  /// OpenCV minEigThreshold (> 0): rejects textureless windows.
+  double min_eigen_threshold = 1e-4;
+  /// Backward tracking scheme of the forward-backward check (ALGORITHM.md: full).
+  ForwardBackwardCheck forward_backward_check = ForwardBackwardCheck::local;
+  /// fb_max (px, > 0): largest |c' - c| accepted by the forward-backward check.
+  float forward_backward_threshold = 1.0f;
+  /// tau_edge (relative, >= 0): bilinear depth needs (max - min) <= tau_edge * min.
+  float depth_edge_tolerance = 0.05f;
+  /// max_flow3d (metres per frame, > 0): a larger |b - a| is a gross error.
+  float max_flow = 0.5f;
+  /// z_ref (metres, > 0): weight = min(1, (z_ref / z)^4), the inverse of the depth-noise
+  /// variance (sigma_z grows as z^2) relative to z_ref; z = the larger of the two depths.
+  float weight_reference_depth = 1.5f;
 
   /// \throws std::invalid_argument naming the first field out of the range stated above
-  void
-  validate() const;
+  void validate() const;
 };
 
 } // namespace dynvo

@@ -85,8 +85,9 @@ GridSceneFlowEstimation<PointT>::initCompute()
     return false;
   }
   if (input_->width != previous_->width || input_->height != previous_->height) {
-    PCL_ERROR("[dynvo::%s::compute] input cloud is %ux%u but previous cloud is %ux%u.\n",
-              name, input_->width, input_->height, previous_->width, previous_->height);
+    PCL_ERROR(
+        "[dynvo::%s::compute] input cloud is %ux%u but previous cloud is %ux%u.\n",
+        name, input_->width, input_->height, previous_->width, previous_->height);
     return false;
   }
   return true;
@@ -116,8 +117,8 @@ GridSceneFlowEstimation<PointT>::prepareFrame(const PointCloud& cloud,
   for (std::size_t i = 0; i < size; ++i) {
     const PointT& p = cloud[i];
     // ITU-R BT.601 luma in 14-bit fixed point, the weights of cv::cvtColor(RGB2GRAY).
-    grey_[i] = static_cast<std::uint8_t>((4899u * p.r + 9617u * p.g + 1868u * p.b + 8192u) >>
-                                         14);
+    grey_[i] = static_cast<std::uint8_t>(
+        (4899u * p.r + 9617u * p.g + 1868u * p.b + 8192u) >> 14);
     depth_[i] = std::isfinite(p.z) ? p.z : std::numeric_limits<float>::quiet_NaN();
   }
   engine_.prepare(slot, grey_, depth_, cloud.width, cloud.height, params_, threads_);

@@ -1,0 +1,56 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Structure-of-arrays view of one grid scene flow (ALGORITHM.md §0 GridFlow).
+#pragma once
+
+#include <dynvo/common/export.h>
+#include <dynvo/common/point_types.h>
+
+#include <pcl/point_cloud.h>
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace dynvo {
+
+/** \brief Per-cell scene flow on plain buffers, cell i = row * cols + col.
+ *
+ * Filled from the organized PointFlow cloud of GridSceneFlowEstimation, so that the
+ * segmentation and tracking math compiles once, independent of the point type.
+ */
+struct DYNVO_EXPORTS GridFlowData {
+  int cols = 0; ///< Gx, grid columns
+  int rows = 0; ///< Gy, grid rows
+  int cell_size =
+      16; ///< w_grid (px); cell (col, row) is centred on (col, row) * w_grid + w_grid / 2
+  std::vector<std::uint8_t> valid_2d; ///< 1 when the 2D track p_i is valid
+  std::vector<std::uint8_t> valid_3d; ///< 1 when a_i and b_i are valid
+  std::vector<Eigen::Vector2f>
+      previous_pixel; ///< p_i (px, previous image); NaN when !valid_2d
+  std::vector<Eigen::Vector3f>
+      a; ///< a_i (metres, previous camera frame); NaN when missing
+  std::vector<Eigen::Vector3f>
+      b; ///< b_i (metres, current camera frame); NaN when no depth at c_i
+
+  /// Number of cells.
+  std::size_t size() const { return valid_3d.size(); }
+
+  /// Centre c_i of cell i (px, current image).
+  Eigen::Vector2f cellCentre(std::size_t i) const
+  {
+    const int col = static_cast<int>(i % static_cast<std::size_t>(cols));
+    const int row = static_cast<int>(i / static_cast<std::size_t>(cols));
+    return {static_cast<float>(col * cell_size + cell_size / 2),
+            static_cast<float>(row * cell_size + cell_size / 2)};
+  }
+
+  /** \brief Copies an organized flow grid.
+   * \param[in] flow organized cols x rows cloud as computed by GridSceneFlowEstimation
+   * \param[in] cell_size w_grid (px) the flow was computed with
+   */
+  void assign(const pcl::PointCloud<PointFlow>& flow, int cell_size);
+};
+
+} // namespace dynvo

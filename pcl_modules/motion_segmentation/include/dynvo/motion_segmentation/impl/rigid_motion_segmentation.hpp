@@ -1,0 +1,228 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Template bodies of RigidMotionSegmentation (compiled in src/ for XYZRGB and XYZRGBA).
+#pragma once
+
+#include <dynvo/motion_segmentation/rigid_motion_segmentation.h>
+
+#include <pcl/console/print.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <thread>
+
+namespace dynvo {
+
+template <typename PointT>
+void
+RigidMotionSegmentation<PointT>::setInputCloud(const PointCloudConstPtr& cloud)
+{
+  Base::setInputCloud(cloud);
+}
+
+template <typename PointT>
+void
+RigidMotionSegmentation<PointT>::setInputFlow(const FlowCloudConstPtr& flow)
+{
+  flow_ = flow;
+}
+
+template <typename PointT>
+void
+RigidMotionSegmentation<PointT>::reset()
+{
+  clearOutputs();
+  tracker_.reset();
+}
+
+template <typename PointT>
+void
+RigidMotionSegmentation<PointT>::setPredictedMotion(const Eigen::Matrix4f& T_curr_prev)
+{
+  if (!T_curr_prev.allFinite())
+    throw std::invalid_argument("[dynvo::" + getClassName() +
+                                "::setPredictedMotion] the motion must be finite");
+  predicted_motion_ = T_curr_prev;
+}
+
+template <typename PointT>
+void
+RigidMotionSegmentation<PointT>::setCameraIntrinsics(const CameraIntrinsics& intrinsics)
+{
+  intrinsics.validate();
+  intrinsics_ = intrinsics;
+}
+
+template <typename PointT>
+void
+RigidMotionSegmentation<PointT>::setNumberOfThreads(unsigned threads)
+{
+  if (threads == 0)
+    throw std::invalid_argument("[dynvo::" + getClassName() +
+                                "::setNumberOfThreads] need at least 1 thread, got 0");
+  threads_ = threads;
+}
+
+template <typename PointT>
+void
+RigidMotionSegmentation<PointT>::setParameters(const Parameters& parameters)
+{
+  parameters.validate();
+  params_ = parameters;
+}
+
+template <typename PointT>
+void
+RigidMotionSegmentation<PointT>::clearOutputs()
+{
+  cell_labels_.clear();
+  segment_labels_.clear();
+  motions_.clear();
+  spatial_ = SpatialSegmentationResult();
+}
+
+template <typename PointT>
+bool
+RigidMotionSegmentation<PointT>::initCompute()
+{
+  const char* name = getClassName().c_str();
+  if (!input_ || !flow_) {
+    PCL_ERROR("[dynvo::%s::segment] %s not set.\n", name,
+              input_ ? "input flow" : "input (current) cloud");
+    return false;
+  }
+  if (!input_->isOrganized() || !flow_->isOrganized()) {
+    PCL_ERROR("[dynvo::%s::segment] %s is not organized.\n", name,
+              input_->isOrganized() ? "input flow" : "input (current) cloud");
+    return false;
+  }
+  return true;
+}
+
+template <typename PointT>
+bool
+RigidMotionSegmentation<PointT>::validateInputs() const
+{
+  const auto cell = static_cast<std::uint32_t>(params_.cell_size);
+  if (flow_->width != input_->width / cell || flow_->height != input_->height / cell ||
+      flow_->empty()) {
+    PCL_ERROR("[dynvo::%s::segment] a %ux%u flow grid does not fit a %ux%u cloud with "
+              "%u px cells.\n",
+              getClassName().c_str(), flow_->width, flow_->height, input_->width,
+              input_->height, cell);
+    return false;
+  }
+  return true;
+}
+
+template <typename PointT>
+void
+RigidMotionSegmentation<PointT>::computeImplIndices(
+    std::vector<pcl::PointIndices>& segments) const
+{
+  // Output position of each label id (label ids are < 256).
+  std::array<int, 256> slot;
+  slot.fill(-1);
+  for (std::size_t s = 0; s < segment_labels_.size(); ++s)
+    slot[segment_labels_[s]] = static_cast<int>(s);
+  const int cell = params_.cell_size;
+  const int width = static_cast<int>(input_->width);
+  const int cols = static_cast<int>(flow_->width);
+  const int rows = static_cast<int>(flow_->height);
+  // Stripes of cell rows on their own threads, concatenated in order: the same indices for
+  // any thread count. Plain threads, not OpenMP: libgomp's spinning join costs more than
+  // this whole loop when other processes share the cores.
+  const int stripes = std::min<int>(static_cast<int>(threads_), rows);
+  std::vector<std::vector<std::vector<int>>> parts(
+      stripes, std::vector<std::vector<int>>(segment_labels_.size()));
+  const auto extract = [&](int stripe) {
+    std::vector<std::vector<int>>& out = parts[stripe];
+    const int first_row = rows * stripe / stripes,
+              end_row = rows * (stripe + 1) / stripes;
+    // Room for every pixel of the stripe's cells, so the loop writes without branching.
+    std::vector<std::size_t> size(out.size(), 0);
+    for (int r = first_row; r < end_row; ++r)
+      for (int c = 0; c < cols; ++c) {
+        const int s = slot[cell_labels_[static_cast<std::size_t>(r) * cols + c]];
+        if (s >= 0)
+          size[s] += static_cast<std::size_t>(cell) * cell;
+      }
+    for (std::size_t s = 0; s < out.size(); ++s)
+      out[s].resize(size[s]);
+    std::fill(size.begin(), size.end(), 0);
+    for (int r = first_row; r < end_row; ++r)
+      for (int v = r * cell; v < (r + 1) * cell; ++v)
+        for (int c = 0; c < cols; ++c) {
+          const int s = slot[cell_labels_[static_cast<std::size_t>(r) * cols + c]];
+          if (s < 0)
+            continue;
+          int* write = out[s].data();
+          std::size_t& n = size[s];
+          const int begin = v * width + c * cell;
+          for (int index = begin; index < begin + cell; ++index) {
+            write[n] = index;
+            n += std::isfinite((*input_)[index].z) ? 1 : 0;
+          }
+        }
+    for (std::size_t s = 0; s < out.size(); ++s)
+      out[s].resize(size[s]);
+  };
+  std::vector<std::thread> workers;
+  for (int stripe = 1; stripe < stripes; ++stripe)
+    workers.emplace_back(extract, stripe);
+  extract(0);
+  for (std::thread& worker : workers)
+    worker.join();
+  segments.assign(segment_labels_.size(), pcl::PointIndices());
+  for (std::size_t s = 0; s < segments.size(); ++s) {
+    segments[s].header = input_->header;
+    for (const auto& part : parts)
+      segments[s].indices.insert(segments[s].indices.end(), part[s].begin(),
+                                 part[s].end());
+  }
+}
+
+template <typename PointT>
+void
+RigidMotionSegmentation<PointT>::segment(std::vector<pcl::PointIndices>& segments)
+{
+  segments.clear();
+  clearOutputs();
+  if (!initCompute())
+    return;
+  struct DeinitGuard {
+    RigidMotionSegmentation& self;
+    ~DeinitGuard() { self.deinitCompute(); }
+  } guard{*this};
+  if (!validateInputs())
+    return;
+  grid_.assign(*flow_, params_.cell_size);
+  segmenter_.segment(grid_, params_, spatial_);
+  PCL_DEBUG("[dynvo::%s::segment] %d segments from %zu hypotheses (%d trials).\n",
+            getClassName().c_str(), spatial_.segmentCount(), spatial_.hypotheses.size(),
+            spatial_.trials);
+  if (params_.tracking) {
+    tracker_.update(grid_, spatial_, predicted_motion_.cast<double>(), intrinsics_,
+                    params_);
+    cell_labels_ = tracker_.labels();
+    segment_labels_ = tracker_.ids();
+    for (const Eigen::Matrix4d& H : tracker_.motions())
+      motions_.push_back(H.cast<float>());
+  }
+  else {
+    // Two-frame result: segments by size, the largest taken as the background.
+    cell_labels_ = spatial_.labels;
+    segment_labels_.push_back(LABEL_STATIC);
+    motions_.push_back(spatial_.motions.empty() ? predicted_motion_
+                                                : spatial_.motions[0].cast<float>());
+    for (int c = 2; c <= spatial_.segmentCount(); ++c) {
+      segment_labels_.push_back(static_cast<std::uint8_t>(c));
+      motions_.push_back(spatial_.motions[c - 1].cast<float>());
+    }
+  }
+  computeImplIndices(segments);
+}
+
+} // namespace dynvo

@@ -1,0 +1,251 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Rigid motion segmentation of a grid scene flow, tracked over a sequence (ALGORITHM.md §2-§6).
+#pragma once
+
+#include <dynvo/common/camera.h>
+#include <dynvo/common/conventions.h>
+#include <dynvo/common/export.h>
+#include <dynvo/common/point_types.h>
+#include <dynvo/motion_segmentation/grid_flow_data.h>
+#include <dynvo/motion_segmentation/rigid_motion_segmentation_parameters.h>
+#include <dynvo/motion_segmentation/segment_tracker.h>
+#include <dynvo/motion_segmentation/spatial_segmentation.h>
+
+#include <pcl/PointIndices.h>
+#include <pcl/pcl_base.h>
+#include <pcl/point_cloud.h>
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace dynvo {
+
+/** \brief Rigid motion segmentation and tracking of Lee, Son & Kim, "Robust Real-time RGB-D
+ * Visual Odometry in Dynamic Environments via Rigid Motion Model", IROS 2019 (arXiv
+ * 1907.08388), §III-B and §III-C.
+ *
+ * Input: the current organized cloud (frame k, where the grid is anchored) and the grid scene
+ * flow from frame k-1 to k (GridSceneFlowEstimation). Every frame, rigid motion hypotheses are
+ * sampled on the flow (entropy-weighted), refined, clustered by DBSCAN and turned into
+ * segments (ALGORITHM.md §3). With tracking on (default), the segments are matched against
+ * the last label maps to get persistent ids, label 1 being the static background (§4), and a
+ * dual-mode per-cell model filters the labels over time (§5, §6).
+ *
+ * Output of segment(): element 0 is always the static background (label 1, possibly empty),
+ * then one pcl::PointIndices per moving object in increasing id order; getSegmentLabels()
+ * gives the ids and getMotions() one T_curr_prev per segment. Indices are linear pixel indices
+ * (row * width + col) of every pixel with finite depth in the cells of the segment.
+ * With tracking off, the segments are the two-frame ones, largest first (its label 1).
+ * \code
+ * dynvo::RigidMotionSegmentation<pcl::PointXYZRGB> segmentation;
+ * segmentation.setCameraIntrinsics(intrinsics);
+ * std::vector<pcl::PointIndices> segments;
+ * for (each frame k >= 1, with its flow from GridSceneFlowEstimation) {
+ *   segmentation.setInputCloud(cloud_k);
+ *   segmentation.setInputFlow(flow_k);
+ *   segmentation.setPredictedMotion(T_curr_prev_of_frame_k_minus_1);
+ *   segmentation.segment(segments); // segments[0]: static background
+ * }
+ * \endcode
+ * Not thread-safe; separate instances may run concurrently. Explicitly instantiated for
+ * pcl::PointXYZRGB and pcl::PointXYZRGBA (other types: include the impl .hpp).
+ */
+template <typename PointT> class RigidMotionSegmentation : public pcl::PCLBase<PointT> {
+public:
+  using Base = pcl::PCLBase<PointT>;
+  using PointCloud = pcl::PointCloud<PointT>;
+  using PointCloudPtr = typename PointCloud::Ptr;
+  using PointCloudConstPtr = typename PointCloud::ConstPtr;
+  using Ptr = pcl::shared_ptr<RigidMotionSegmentation<PointT>>;
+  using ConstPtr = pcl::shared_ptr<const RigidMotionSegmentation<PointT>>;
+  using FlowCloud = pcl::PointCloud<PointFlow>;
+  using FlowCloudConstPtr = FlowCloud::ConstPtr;
+  using Parameters = RigidMotionSegmentationParameters;
+  using Motions =
+      std::vector<Eigen::Matrix4f, Eigen::aligned_allocator<Eigen::Matrix4f>>;
+
+  RigidMotionSegmentation() = default;
+
+  /// Name used in log prefixes: "RigidMotionSegmentation".
+  const std::string& getClassName() const { return class_name_; }
+
+  /// Current frame k (organized, metres); the pixel indices of segment() refer to it.
+  void setInputCloud(const PointCloudConstPtr& cloud) override;
+
+  /// Grid scene flow from frame k-1 to frame k (organized, (width / w_grid) x (height / w_grid)).
+  void setInputFlow(const FlowCloudConstPtr& flow);
+
+  const FlowCloudConstPtr& getInputFlow() const { return flow_; }
+
+  /** \brief Segments the current frame by rigid motion.
+   * \param[out] segments element 0 = static background, then moving objects by id (see
+   *             the class doc); empty when the inputs break the contract (null,
+   *             unorganized, flow grid not matching the cloud), which is logged with PCL_ERROR
+   */
+  void segment(std::vector<pcl::PointIndices>& segments);
+
+  /// Label id of each segment of the last segment() (element 0 is 1).
+  const std::vector<std::uint8_t>& getSegmentLabels() const { return segment_labels_; }
+
+  /// T_curr_prev of each segment of the last segment() (maps frame k-1 points to frame k).
+  const Motions& getMotions() const { return motions_; }
+
+  /// Output label per grid cell (row-major, cols x rows of the flow): 0 none, 1 static, 2.. objects.
+  const std::vector<std::uint8_t>& getCellLabels() const { return cell_labels_; }
+
+  /// The two-frame segmentation of the last segment() (G, one motion per segment, ALGORITHM.md §3).
+  const SpatialSegmentationResult& getSpatialSegmentation() const { return spatial_; }
+
+  /// The tracker state (tracked labels Ghat, model labels L, ALGORITHM.md §4-§6).
+  const SegmentTracker& getTracker() const { return tracker_; }
+
+  /** \brief Forgets the sequence (label buffer and models): the next segment() starts a new
+   * one. Parameter setters keep the sequence; a new grid size or max_labels restarts it.
+   */
+  void reset();
+
+  /** \brief Constant-velocity prediction H_pred: the previous frame's ego-motion T_curr_prev
+   * (metres). Used by the static-background guard (§4) and the compensation fallback (§6).
+   * Default identity; the pipeline sets it before every segment().
+   */
+  void setPredictedMotion(const Eigen::Matrix4f& T_curr_prev);
+
+  const Eigen::Matrix4f& getPredictedMotion() const { return predicted_motion_; }
+
+  /// Intrinsics of the current frame (§6 reprojection). \throws std::invalid_argument when invalid
+  void setCameraIntrinsics(const CameraIntrinsics& intrinsics);
+
+  const CameraIntrinsics& getCameraIntrinsics() const { return intrinsics_; }
+
+  /** \brief Worker threads (default 1) for the per-pixel index extraction; the per-cell
+   * stages take well under a millisecond and stay on the caller's thread. Results are
+   * identical for any count. \throws std::invalid_argument on 0
+   */
+  void setNumberOfThreads(unsigned threads);
+
+  unsigned getNumberOfThreads() const { return threads_; }
+
+  /// All knobs at once. \throws std::invalid_argument when parameters.validate() fails
+  void setParameters(const Parameters& parameters);
+
+  const Parameters& getParameters() const { return params_; }
+
+  // One setter/getter pair per field of Parameters; each throws std::invalid_argument on a
+  // value out of the range documented in RigidMotionSegmentationParameters.
+  void setCellSize(int px) { updateField(&Parameters::cell_size, px); }
+  int getCellSize() const { return params_.cell_size; }
+  void setMaxHypotheses(int count) { updateField(&Parameters::max_hypotheses, count); }
+  int getMaxHypotheses() const { return params_.max_hypotheses; }
+  void setMaxTrials(int count) { updateField(&Parameters::max_trials, count); }
+  int getMaxTrials() const { return params_.max_trials; }
+  void setSampleSize(int points) { updateField(&Parameters::sample_size, points); }
+  int getSampleSize() const { return params_.sample_size; }
+  void setSearchRadius(int cells) { updateField(&Parameters::search_radius, cells); }
+  int getSearchRadius() const { return params_.search_radius; }
+  void setInlierThreshold(float m2) { updateField(&Parameters::inlier_threshold, m2); }
+  float getInlierThreshold() const { return params_.inlier_threshold; }
+  void setEntropyLambda(float per_m2)
+  {
+    updateField(&Parameters::entropy_lambda, per_m2);
+  }
+  float getEntropyLambda() const { return params_.entropy_lambda; }
+  void setEntropyDelta(float delta) { updateField(&Parameters::entropy_delta, delta); }
+  float getEntropyDelta() const { return params_.entropy_delta; }
+  void setRefineIterations(int rounds)
+  {
+    updateField(&Parameters::refine_iterations, rounds);
+  }
+  int getRefineIterations() const { return params_.refine_iterations; }
+  void setEntropyDone(float mean) { updateField(&Parameters::entropy_done, mean); }
+  float getEntropyDone() const { return params_.entropy_done; }
+  void setEntropySaturation(float drop)
+  {
+    updateField(&Parameters::entropy_saturation, drop);
+  }
+  float getEntropySaturation() const { return params_.entropy_saturation; }
+  void setDbscanMinPoints(int count)
+  {
+    updateField(&Parameters::dbscan_min_points, count);
+  }
+  int getDbscanMinPoints() const { return params_.dbscan_min_points; }
+  void setDbscanEpsilon(float metres)
+  {
+    updateField(&Parameters::dbscan_epsilon, metres);
+  }
+  float getDbscanEpsilon() const { return params_.dbscan_epsilon; }
+  void setMinSegmentSize(int cells)
+  {
+    updateField(&Parameters::min_segment_size, cells);
+  }
+  int getMinSegmentSize() const { return params_.min_segment_size; }
+  void setTracking(bool on) { updateField(&Parameters::tracking, on); }
+  bool getTracking() const { return params_.tracking; }
+  void setMaxLabels(int count) { updateField(&Parameters::max_labels, count); }
+  int getMaxLabels() const { return params_.max_labels; }
+  void setMaxAge(float frames) { updateField(&Parameters::max_age, frames); }
+  float getMaxAge() const { return params_.max_age; }
+  void setBufferLength(int frames) { updateField(&Parameters::buffer_length, frames); }
+  int getBufferLength() const { return params_.buffer_length; }
+  void setMinCorrelation(float c) { updateField(&Parameters::min_correlation, c); }
+  float getMinCorrelation() const { return params_.min_correlation; }
+  void setStaticGuardTolerance(float metres)
+  {
+    updateField(&Parameters::static_guard_tolerance, metres);
+  }
+  float getStaticGuardTolerance() const { return params_.static_guard_tolerance; }
+  void setStaticMinCells(int cells)
+  {
+    updateField(&Parameters::static_min_cells, cells);
+  }
+  int getStaticMinCells() const { return params_.static_min_cells; }
+  void setSeed(std::uint32_t seed) { updateField(&Parameters::seed, seed); }
+  std::uint32_t getSeed() const { return params_.seed; }
+
+protected:
+  using Base::deinitCompute;
+  using Base::input_;
+
+  /// Non-null, organized input cloud and flow; logs PCL_ERROR and returns false otherwise.
+  bool initCompute();
+
+  /// The flow grid is (width / w_grid) x (height / w_grid); logs PCL_ERROR otherwise.
+  bool validateInputs() const;
+
+  /// Fills segments with the pixels of each labelled cell, in segment_labels_ order.
+  void computeImplIndices(std::vector<pcl::PointIndices>& segments) const;
+
+private:
+  template <typename Field> void updateField(Field Parameters::*field, Field value)
+  {
+    Parameters updated = params_;
+    updated.*field = value;
+    setParameters(updated);
+  }
+
+  /// Clears every output of segment().
+  void clearOutputs();
+
+  std::string class_name_ = "RigidMotionSegmentation"; ///< log prefix
+  Parameters params_;                                  ///< validated knobs
+  CameraIntrinsics intrinsics_; ///< current-frame intrinsics (default preset)
+  unsigned threads_ = 1;        ///< worker threads
+  Eigen::Matrix4f predicted_motion_ =
+      Eigen::Matrix4f::Identity();           ///< H_pred (T_curr_prev)
+  FlowCloudConstPtr flow_;                   ///< scene flow k-1 -> k
+  GridFlowData grid_;                        ///< flow on plain buffers
+  SpatialSegmenter segmenter_;               ///< §3 with its scratch buffers
+  SpatialSegmentationResult spatial_;        ///< §3 result of the last frame
+  SegmentTracker tracker_;                   ///< §4-§6 state across frames
+  std::vector<std::uint8_t> cell_labels_;    ///< output label per cell
+  std::vector<std::uint8_t> segment_labels_; ///< id of each output segment
+  Motions motions_;                          ///< T_curr_prev of each output segment
+};
+
+} // namespace dynvo
+
+#ifdef DYNVO_NO_PRECOMPILE
+#include <dynvo/motion_segmentation/impl/rigid_motion_segmentation.hpp>
+#endif

@@ -1,0 +1,126 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Motion segment tracking: matching, static-background guard, dual model (ALGORITHM.md §4-§6).
+#pragma once
+
+#include <dynvo/common/camera.h>
+#include <dynvo/common/export.h>
+#include <dynvo/motion_segmentation/dual_label_model.h>
+#include <dynvo/motion_segmentation/grid_flow_data.h>
+#include <dynvo/motion_segmentation/rigid_motion_segmentation_parameters.h>
+#include <dynvo/motion_segmentation/spatial_segmentation.h>
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <deque>
+#include <vector>
+
+namespace dynvo {
+
+/** \brief Correlation matching of segments against one past label map (paper eqs. 3-7).
+ *
+ * C_ij = N_ij / sqrt(N_i N_j) for segment i of `segments` (1..g) and label j of `past`
+ * (1..n_obj); id 0 never pairs.
+ * \param[in] segments G per cell (0..g)
+ * \param[in] past a past label map warped into the current grid (0..n_obj)
+ * \param[in] segment_count g
+ * \param[in] labels n_obj
+ * \param[out] correlation (g + 1) x (n_obj + 1) row-major, row/column 0 unused (0)
+ * \return score(k, l) = sum_i N_i max_j C_ij / sum_i N_i (0 when no cell is labelled)
+ */
+DYNVO_EXPORTS double correlateLabelMaps(const std::vector<std::uint8_t>& segments,
+                                        const std::vector<std::uint8_t>& past,
+                                        int segment_count,
+                                        int labels,
+                                        std::vector<double>& correlation);
+
+/** \brief Tracker turning per-frame segments into persistent labels (ALGORITHM.md §4-§6).
+ *
+ * Per frame: warps the buffered label maps and the models into the current grid with the
+ * scene flow, matches the segments (label 1 = static background, guarded by the
+ * constant-velocity prediction), updates the dual-mode model and reads out the labels.
+ * Outputs per cell: the tracked measurement Ghat (trackedLabels), the model read-out L
+ * (modelLabels) and their fusion (labels): an object id from either wins, otherwise Ghat,
+ * so a cell is static only when measured static and not held as an object by the model.
+ */
+class DYNVO_EXPORTS SegmentTracker {
+public:
+  /// Forgets the sequence: empty buffer, uninitialised models, no background yet.
+  void reset();
+
+  /** \brief Processes one frame.
+   * \param[in] grid scene flow k-1 -> k
+   * \param[in] spatial the two-frame segmentation of the frame (§3)
+   * \param[in] T_pred H_pred, the constant-velocity prediction of the ego-motion T_curr_prev
+   * \param[in] intrinsics current-frame intrinsics (§6 reprojection fallback)
+   * \param[in] params validated parameters
+   */
+  void update(const GridFlowData& grid,
+              const SpatialSegmentationResult& spatial,
+              const Eigen::Matrix4d& T_pred,
+              const CameraIntrinsics& intrinsics,
+              const RigidMotionSegmentationParameters& params);
+
+  /// Ghat per cell: tracked id of the cell's segment this frame (0 = no measurement).
+  const std::vector<std::uint8_t>& trackedLabels() const { return tracked_; }
+
+  /// L per cell: the dual model's read-out (0 = unknown).
+  const std::vector<std::uint8_t>& modelLabels() const { return model_.readOut(); }
+
+  /// Fused output label per cell (see the class doc).
+  const std::vector<std::uint8_t>& labels() const { return fused_; }
+
+  /// Output ids: 1 first, then every object id present in labels(), ascending.
+  const std::vector<std::uint8_t>& ids() const { return ids_; }
+
+  /// T_curr_prev of each id in ids() (the matched segment's motion, else a fit on the cells).
+  const std::vector<Eigen::Matrix4d>& motions() const { return motions_; }
+
+  /// The dual-mode model after this frame.
+  const DualLabelModel& model() const { return model_; }
+
+private:
+  /// p_i per cell with the §6 fallbacks (reprojection with H_pred, neighbour median, zero).
+  void sourcePixels(const GridFlowData& grid,
+                    const Eigen::Matrix4d& T_pred,
+                    const CameraIntrinsics& intrinsics);
+
+  /// Nearest-cell warp of a previous-grid map into the current grid (valid_2d only).
+  std::vector<std::uint8_t> warpNearest(const std::vector<std::uint8_t>& map,
+                                        const GridFlowData& grid) const;
+
+  /// §4: tracked id of each segment (index 1..g; 0 = none).
+  std::vector<int> matchSegments(const SpatialSegmentationResult& spatial,
+                                 const RigidMotionSegmentationParameters& params) const;
+
+  /// §4 static-background guard on the segment ids.
+  void guardBackground(const GridFlowData& grid,
+                       const SpatialSegmentationResult& spatial,
+                       const Eigen::Matrix4d& T_pred,
+                       const RigidMotionSegmentationParameters& params,
+                       std::vector<int>& ids) const;
+
+  /// Marks the ids held by a buffered map or as argmax of an initialised model (used_).
+  void collectUsedIds(int labels);
+
+  /// Smallest id in 2..n_obj neither in used_ nor in `taken`; 0 if none.
+  int freeId(const std::vector<int>& taken) const;
+
+  /// Output ids and one motion per id.
+  void collectOutputs(const GridFlowData& grid,
+                      const SpatialSegmentationResult& spatial,
+                      const std::vector<int>& segment_ids,
+                      const Eigen::Matrix4d& T_pred);
+
+  std::deque<std::vector<std::uint8_t>>
+      buffer_;                           ///< Ghat of past frames, warped, newest first
+  DualLabelModel model_;                 ///< apparent / candidate models
+  std::vector<Eigen::Vector2f> source_;  ///< p_i used for compensation
+  std::vector<std::uint8_t> tracked_;    ///< Ghat
+  std::vector<std::uint8_t> fused_;      ///< output labels
+  std::vector<std::uint8_t> ids_;        ///< output ids
+  std::vector<Eigen::Matrix4d> motions_; ///< motion per output id
+  std::vector<char> used_;               ///< ids taken at the start of the frame
+};
+
+} // namespace dynvo

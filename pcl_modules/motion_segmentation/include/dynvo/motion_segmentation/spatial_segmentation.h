@@ -1,0 +1,119 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Two-frame rigid motion segmentation: hypotheses, refinement, DBSCAN, labels (ALGORITHM.md §3).
+#pragma once
+
+#include <dynvo/common/export.h>
+#include <dynvo/motion_segmentation/grid_flow_data.h>
+#include <dynvo/motion_segmentation/rigid_motion_segmentation_parameters.h>
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <random>
+#include <vector>
+
+namespace dynvo {
+
+/// One accepted motion hypothesis (ALGORITHM.md §3.3).
+struct MotionHypothesis {
+  Eigen::Matrix4d T_curr_prev = Eigen::Matrix4d::Identity(); ///< H mapping a_i to b_i
+  std::vector<int> inliers; ///< points with E_i(H) <= th_inlier, ascending indices
+};
+
+/// Output of SpatialSegmenter::segment (ALGORITHM.md §3.6, SegResult).
+struct SpatialSegmentationResult {
+  std::vector<std::uint8_t>
+      labels; ///< G_i per cell: 0 = no valid motion, 1..g by size (1 largest)
+  std::vector<Eigen::Matrix4d>
+      motions;            ///< H_c (T_curr_prev) of segment c at index c - 1
+  std::vector<int> sizes; ///< N_c, cells of segment c at index c - 1
+  std::vector<MotionHypothesis>
+      hypotheses; ///< accepted hypotheses, inliers as cell indices
+  int trials = 0; ///< trials made, failed ones included
+
+  /// Number of segments g.
+  int segmentCount() const { return static_cast<int>(sizes.size()); }
+};
+
+/** \brief DBSCAN over a precomputed distance matrix (Yarpiz MATLAB DBSCAN semantics).
+ *
+ * The neighbourhood of an item includes the item itself; an item is a core point when its
+ * neighbourhood (distance <= epsilon) holds at least min_points items. With min_points = 1
+ * this is single-linkage connected components and no item is noise.
+ * \param[in] distances count x count symmetric matrix, row-major
+ * \param[in] count number of items
+ * \param[in] epsilon neighbourhood radius (same unit as distances)
+ * \param[in] min_points core-point size (>= 1)
+ * \return cluster id per item (0, 1, ... in order of discovery), -1 for noise
+ */
+DYNVO_EXPORTS std::vector<int>
+dbscan(const std::vector<double>& distances, int count, double epsilon, int min_points);
+
+/** \brief Motion-field distance of two hypotheses (metres, ALGORITHM.md §3.5):
+ * sqrt(mean over i in I_x u I_y of ||(R_x - R_y) a_i + (t_x - t_y)||^2); 0 when both
+ * are empty.
+ * \param[in] a points the inlier indices refer to (metres, previous camera frame)
+ */
+DYNVO_EXPORTS double motionFieldDistance(const MotionHypothesis& x,
+                                         const MotionHypothesis& y,
+                                         const std::vector<Eigen::Vector3f>& a);
+
+/** \brief The two-frame segmentation of ALGORITHM.md §3 on the valid_3d cells of a grid.
+ *
+ * Entropy-weighted seeds (std::discrete_distribution on a std::mt19937 seeded with
+ * params.seed at every call), m - 1 distinct neighbours within r_search cells, a 7-point fit
+ * accepted when every sample point is an inlier, up to refine_iterations inlier/refit rounds,
+ * the three stopping rules, DBSCAN with the motion-field distance, and labelling with
+ * small-segment removal. The scratch buffers are kept between calls. Deterministic: the
+ * result depends on the input and params only. Single-threaded on purpose: each per-cell
+ * loop is a few microseconds, less than an OpenMP fork/join (with another process on the
+ * cores, libgomp's spinning joins cost 700 ms per frame with 2 threads, measured).
+ */
+class DYNVO_EXPORTS SpatialSegmenter {
+public:
+  /** \param[in] grid scene flow of the frame pair
+   *  \param[in] params validated parameters
+   *  \param[out] result labels per cell and one motion per segment (all 0 and no segment
+   *              when fewer than 2 m cells are valid_3d)
+   */
+  void segment(const GridFlowData& grid,
+               const RigidMotionSegmentationParameters& params,
+               SpatialSegmentationResult& result);
+
+private:
+  /// Fills errors_ with E_k(H) for every packed point.
+  void evaluate(const Eigen::Matrix4d& H);
+
+  /// Draws one hypothesis; false when the trial fails.
+  bool tryHypothesis(const RigidMotionSegmentationParameters& params,
+                     MotionHypothesis& hypothesis);
+
+  /// DBSCAN of the accepted hypotheses; returns the cluster of each one.
+  std::vector<int>
+  clusterHypotheses(const RigidMotionSegmentationParameters& params) const;
+
+  /// Labels the grid from the clusters and fills result (ALGORITHM.md §3.6).
+  void label(const std::vector<int>& clusters,
+             const RigidMotionSegmentationParameters& params,
+             SpatialSegmentationResult& result);
+
+  int cols_ = 0;                    ///< grid columns
+  int rows_ = 0;                    ///< grid rows
+  std::vector<int> packed_of_cell_; ///< packed index of each cell, -1 when not valid_3d
+  std::vector<int> cell_of_packed_; ///< cell index of each packed point
+  std::vector<Eigen::Vector3f> a_;  ///< packed a_i
+  std::vector<Eigen::Vector3f> b_;  ///< packed b_i
+  std::vector<float> errors_;       ///< E_k of the hypothesis being evaluated
+  std::vector<float> min_errors_;   ///< min over accepted hypotheses of E_k
+  std::vector<double> entropy_;     ///< S_k
+  std::vector<int> candidates_;     ///< neighbours of the current seed
+  std::vector<int> sample_;         ///< the m sampled points
+  std::vector<int> inliers_;        ///< inlier scratch
+  std::vector<MotionHypothesis>
+      accepted_; ///< hypotheses of this frame (packed indices)
+  using Draw = std::discrete_distribution<int>;
+  std::mt19937 rng_; ///< sampling RNG
+  Draw draw_;        ///< seed distribution S_k / sum S, rebuilt on acceptance
+};
+
+} // namespace dynvo

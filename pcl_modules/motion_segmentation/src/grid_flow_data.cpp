@@ -1,0 +1,36 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Copy of an organized PointFlow grid into plain per-cell buffers.
+#include <dynvo/motion_segmentation/grid_flow_data.h>
+
+#include <cmath>
+#include <limits>
+
+namespace dynvo {
+
+void
+GridFlowData::assign(const pcl::PointCloud<PointFlow>& flow, int cell_size_px)
+{
+  constexpr float NaN = std::numeric_limits<float>::quiet_NaN();
+  cols = static_cast<int>(flow.width);
+  rows = static_cast<int>(flow.height);
+  cell_size = cell_size_px;
+  const std::size_t n = flow.size();
+  valid_2d.resize(n);
+  valid_3d.resize(n);
+  previous_pixel.resize(n);
+  a.resize(n);
+  b.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const PointFlow& f = flow[i];
+    valid_2d[i] = f.valid_2d && std::isfinite(f.prev_u) && std::isfinite(f.prev_v);
+    valid_3d[i] = valid_2d[i] && f.valid_3d && std::isfinite(f.x) &&
+                  std::isfinite(f.y) && std::isfinite(f.z) && std::isfinite(f.prev_x) &&
+                  std::isfinite(f.prev_y) && std::isfinite(f.prev_z);
+    previous_pixel[i] =
+        valid_2d[i] ? Eigen::Vector2f(f.prev_u, f.prev_v) : Eigen::Vector2f(NaN, NaN);
+    a[i] = Eigen::Vector3f(f.prev_x, f.prev_y, f.prev_z);
+    b[i] = Eigen::Vector3f(f.x, f.y, f.z);
+  }
+}
+
+} // namespace dynvo

@@ -1,0 +1,337 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Motion segment tracking (ALGORITHM.md §4-§6).
+#include <dynvo/motion_segmentation/segment_tracker.h>
+
+#include <dynvo/common/conventions.h>
+#include <dynvo/common/rigid_fit.h>
+
+#include <pcl/console/print.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <tuple>
+
+namespace dynvo {
+
+namespace {
+
+/// Median of a non-empty list (upper median for even sizes).
+float
+median(std::vector<float>& values)
+{
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
+} // namespace
+
+double
+correlateLabelMaps(const std::vector<std::uint8_t>& segments,
+                   const std::vector<std::uint8_t>& past,
+                   int segment_count,
+                   int labels,
+                   std::vector<double>& correlation)
+{
+  const int stride = labels + 1;
+  std::vector<int> joint(static_cast<std::size_t>(segment_count + 1) * stride, 0);
+  std::vector<int> n_i(segment_count + 1, 0), n_j(stride, 0);
+  for (std::size_t c = 0; c < segments.size(); ++c) {
+    const int i = segments[c];
+    const int j = past[c] <= labels ? past[c] : 0;
+    ++n_i[i];
+    ++n_j[j];
+    ++joint[static_cast<std::size_t>(i) * stride + j];
+  }
+  correlation.assign(joint.size(), 0.0);
+  double weighted = 0.0;
+  long total = 0;
+  for (int i = 1; i <= segment_count; ++i) {
+    double best = 0.0;
+    for (int j = 1; j <= labels; ++j) {
+      const int both = joint[static_cast<std::size_t>(i) * stride + j];
+      if (both == 0)
+        continue;
+      const double c = both / std::sqrt(static_cast<double>(n_i[i]) * n_j[j]);
+      correlation[static_cast<std::size_t>(i) * stride + j] = c;
+      best = std::max(best, c);
+    }
+    weighted += n_i[i] * best;
+    total += n_i[i];
+  }
+  return total == 0 ? 0.0 : weighted / static_cast<double>(total);
+}
+
+void
+SegmentTracker::reset()
+{
+  buffer_.clear();
+  model_ = DualLabelModel();
+  source_.clear();
+  tracked_.clear();
+  fused_.clear();
+  ids_.clear();
+  motions_.clear();
+}
+
+std::vector<std::uint8_t>
+SegmentTracker::warpNearest(const std::vector<std::uint8_t>& map,
+                            const GridFlowData& grid) const
+{
+  std::vector<std::uint8_t> warped(grid.size(), 0);
+  const float half = static_cast<float>(grid.cell_size / 2);
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    if (!grid.valid_2d[i])
+      continue;
+    const Eigen::Vector2f& p = grid.previous_pixel[i];
+    const long a = std::lround((p.x() - half) / grid.cell_size);
+    const long b = std::lround((p.y() - half) / grid.cell_size);
+    if (a >= 0 && a < grid.cols && b >= 0 && b < grid.rows)
+      warped[i] = map[static_cast<std::size_t>(b) * grid.cols + a];
+  }
+  return warped;
+}
+
+void
+SegmentTracker::sourcePixels(const GridFlowData& grid,
+                             const Eigen::Matrix4d& T_pred,
+                             const CameraIntrinsics& intrinsics)
+{
+  const Eigen::Matrix3f R_t = T_pred.topLeftCorner<3, 3>().transpose().cast<float>();
+  const Eigen::Vector3f t = T_pred.topRightCorner<3, 1>().cast<float>();
+  source_.resize(grid.size());
+  std::vector<float> dx, dy;
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    if (grid.valid_2d[i]) {
+      source_[i] = grid.previous_pixel[i];
+      continue;
+    }
+    const Eigen::Vector2f centre = grid.cellCentre(i);
+    // (1) The point seen at c_i, moved back into frame k-1 by H_pred^-1, reprojected.
+    if (grid.b[i].allFinite()) {
+      const Eigen::Vector3f previous = R_t * (grid.b[i] - t);
+      if (previous.z() > 0.0f) {
+        source_[i] = intrinsics.project(previous);
+        continue;
+      }
+    }
+    // (2) Median displacement of the tracked 3x3 neighbours; (3) zero.
+    dx.clear();
+    dy.clear();
+    const int col = static_cast<int>(i % grid.cols),
+              row = static_cast<int>(i / grid.cols);
+    for (int r = std::max(0, row - 1); r <= std::min(grid.rows - 1, row + 1); ++r)
+      for (int c = std::max(0, col - 1); c <= std::min(grid.cols - 1, col + 1); ++c) {
+        const std::size_t j = static_cast<std::size_t>(r) * grid.cols + c;
+        if (!grid.valid_2d[j])
+          continue;
+        const Eigen::Vector2f d = grid.previous_pixel[j] - grid.cellCentre(j);
+        dx.push_back(d.x());
+        dy.push_back(d.y());
+      }
+    source_[i] = dx.empty() ? centre : centre + Eigen::Vector2f(median(dx), median(dy));
+  }
+}
+
+void
+SegmentTracker::collectUsedIds(int labels)
+{
+  used_.assign(labels + 1, 0);
+  for (const auto& map : buffer_)
+    for (const std::uint8_t l : map)
+      used_[std::min<int>(l, labels)] = 1;
+  for (std::size_t i = 0; i < model_.readOut().size(); ++i)
+    for (const auto m :
+         {DualLabelModel::Model::apparent, DualLabelModel::Model::candidate})
+      used_[model_.argmax(m, i)] = 1;
+}
+
+int
+SegmentTracker::freeId(const std::vector<int>& taken) const
+{
+  const int labels = static_cast<int>(used_.size()) - 1;
+  for (int id = 2; id <= labels; ++id)
+    if (!used_[id] && std::find(taken.begin(), taken.end(), id) == taken.end())
+      return id;
+  return 0;
+}
+
+std::vector<int>
+SegmentTracker::matchSegments(const SpatialSegmentationResult& spatial,
+                              const RigidMotionSegmentationParameters& params) const
+{
+  const int g = spatial.segmentCount();
+  std::vector<int> ids(g + 1, 0);
+  const bool history = std::any_of(buffer_.begin(), buffer_.end(), [](const auto& map) {
+    return std::any_of(map.begin(), map.end(), [](std::uint8_t l) {
+      return l != 0;
+    });
+  });
+  if (!history) {
+    // First pair: the largest segment is the background, the others 2, 3, ... by size.
+    for (int i = 1; i <= g; ++i)
+      ids[i] = i <= params.max_labels ? i : 0;
+    return ids;
+  }
+  // Correlation with every buffered frame; frames in order of score (ties: most recent).
+  const int labels = params.max_labels;
+  std::vector<std::vector<double>> correlation(buffer_.size());
+  std::vector<std::pair<double, std::size_t>> frames;
+  for (std::size_t l = 0; l < buffer_.size(); ++l)
+    frames.emplace_back(
+        -correlateLabelMaps(spatial.labels, buffer_[l], g, labels, correlation[l]), l);
+  std::stable_sort(frames.begin(), frames.end());
+  // Greedy one-to-one assignment on the best frame l_m; [D] segments left unmatched there
+  // try the other buffered frames in score order, so an object missed in one frame keeps
+  // its id.
+  std::vector<char> taken(labels + 1, 0);
+  for (const auto& frame : frames) {
+    const std::vector<double>& C = correlation[frame.second];
+    std::vector<std::tuple<double, int, int>> pairs;
+    for (int i = 1; i <= g; ++i)
+      for (int j = 1; j <= labels; ++j) {
+        const double c = C[static_cast<std::size_t>(i) * (labels + 1) + j];
+        if (ids[i] == 0 && !taken[j] && c >= params.min_correlation)
+          pairs.emplace_back(-c, i, j);
+      }
+    std::sort(pairs.begin(), pairs.end());
+    for (const auto& [c, i, j] : pairs)
+      if (ids[i] == 0 && !taken[j]) {
+        ids[i] = j;
+        taken[j] = 1;
+      }
+  }
+  // New ids for unmatched segments, largest first.
+  for (int i = 1; i <= g; ++i)
+    if (ids[i] == 0) {
+      ids[i] = freeId(ids);
+      if (ids[i] == 0)
+        PCL_WARN(
+            "[dynvo::SegmentTracker::update] all %d labels in use; a segment of %d "
+            "cells is left unlabelled.\n",
+            labels, spatial.sizes[i - 1]);
+    }
+  return ids;
+}
+
+void
+SegmentTracker::guardBackground(const GridFlowData& grid,
+                                const SpatialSegmentationResult& spatial,
+                                const Eigen::Matrix4d& T_pred,
+                                const RigidMotionSegmentationParameters& params,
+                                std::vector<int>& ids) const
+{
+  const int g = spatial.segmentCount();
+  if (g == 0)
+    return;
+  // r_pred(c): RMS residual of segment c under the constant-velocity prediction (metres).
+  std::vector<double> sum(g + 1, 0.0);
+  for (std::size_t i = 0; i < grid.size(); ++i)
+    if (spatial.labels[i] != 0)
+      sum[spatial.labels[i]] += squaredTransferError(T_pred, grid.a[i].cast<double>(),
+                                                     grid.b[i].cast<double>());
+  int c1 = 0, best = 0;
+  std::vector<double> r(g + 1, 0.0);
+  for (int c = 1; c <= g; ++c) {
+    r[c] = std::sqrt(sum[c] / spatial.sizes[c - 1]);
+    if (ids[c] == LABEL_STATIC)
+      c1 = c;
+    if (spatial.sizes[c - 1] >= params.static_min_cells &&
+        (best == 0 || r[c] < r[best]))
+      best = c;
+  }
+  const double tau = params.static_guard_tolerance;
+  const bool c1_fails = c1 != 0 && r[c1] > tau;
+  if (best != 0 && r[best] <= tau && best != c1 && (c1 == 0 || c1_fails)) {
+    const int previous = ids[best];
+    ids[best] = LABEL_STATIC;
+    if (c1 != 0)
+      ids[c1] = previous != 0 ? previous : freeId(ids);
+    PCL_DEBUG("[dynvo::SegmentTracker::update] label 1 moved to a segment of %d cells "
+              "(r_pred %.3f m).\n",
+              spatial.sizes[best - 1], r[best]);
+  }
+  else if (c1_fails) {
+    // [D] No segment agrees with H_pred: no cell is static, and the former background is
+    // left unmeasured this frame rather than turned into an object.
+    ids[c1] = 0;
+    PCL_DEBUG(
+        "[dynvo::SegmentTracker::update] no segment agrees with H_pred; no label 1.\n");
+  }
+}
+
+void
+SegmentTracker::collectOutputs(const GridFlowData& grid,
+                               const SpatialSegmentationResult& spatial,
+                               const std::vector<int>& segment_ids,
+                               const Eigen::Matrix4d& T_pred)
+{
+  const std::vector<std::uint8_t>& model = model_.readOut();
+  fused_.resize(grid.size());
+  std::vector<char> present(256, 0);
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    const std::uint8_t t = tracked_[i], l = model[i];
+    fused_[i] = t > LABEL_STATIC ? t : (l > LABEL_STATIC ? l : t);
+    present[fused_[i]] = 1;
+  }
+  ids_.assign(1, LABEL_STATIC);
+  for (int id = LABEL_STATIC + 1; id < 256; ++id)
+    if (present[id])
+      ids_.push_back(static_cast<std::uint8_t>(id));
+  motions_.clear();
+  for (const std::uint8_t id : ids_) {
+    const auto matched = std::find(segment_ids.begin() + 1, segment_ids.end(), id);
+    if (matched != segment_ids.end()) {
+      motions_.push_back(spatial.motions[matched - segment_ids.begin() - 1]);
+      continue;
+    }
+    RigidFitAccumulator fit;
+    for (std::size_t i = 0; i < grid.size(); ++i)
+      if (fused_[i] == id && grid.valid_3d[i])
+        fit.add(grid.a[i].cast<double>(), grid.b[i].cast<double>());
+    Eigen::Matrix4d H = id == LABEL_STATIC ? T_pred : Eigen::Matrix4d::Identity();
+    fit.solve(H); // keeps the fallback when the cells do not determine a motion
+    motions_.push_back(H);
+  }
+}
+
+void
+SegmentTracker::update(const GridFlowData& grid,
+                       const SpatialSegmentationResult& spatial,
+                       const Eigen::Matrix4d& T_pred,
+                       const CameraIntrinsics& intrinsics,
+                       const RigidMotionSegmentationParameters& params)
+{
+  if (model_.cols() != grid.cols || model_.rows() != grid.rows ||
+      model_.labels() != params.max_labels) {
+    if (model_.cols() != 0)
+      PCL_DEBUG(
+          "[dynvo::SegmentTracker::update] grid or label count changed; restarting.\n");
+    reset();
+    model_.reset(grid.cols, grid.rows, params.max_labels);
+  }
+  collectUsedIds(params.max_labels);
+  for (auto& map : buffer_)
+    map = warpNearest(map, grid);
+
+  // §4: persistent ids for this frame's segments.
+  std::vector<int> ids = matchSegments(spatial, params);
+  guardBackground(grid, spatial, T_pred, params, ids);
+  tracked_.resize(grid.size());
+  for (std::size_t i = 0; i < grid.size(); ++i)
+    tracked_[i] = static_cast<std::uint8_t>(ids[spatial.labels[i]]);
+
+  // §6 then §5: carry the models into the current grid, fold in Ghat, read out L.
+  sourcePixels(grid, T_pred, intrinsics);
+  model_.compensate(source_, grid.valid_2d, grid.cell_size);
+  model_.update(tracked_, params.max_age);
+
+  collectOutputs(grid, spatial, ids, T_pred);
+  buffer_.push_front(tracked_);
+  while (static_cast<int>(buffer_.size()) > params.buffer_length)
+    buffer_.pop_back();
+}
+
+} // namespace dynvo

@@ -1,0 +1,201 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// RigidMotionSegmentation<PointT>: contract, identity, known motion, typed tests.
+#include <dynvo/motion_segmentation/rigid_motion_segmentation.h>
+
+#include "synthetic_flow.h"
+
+#include <pcl/point_types.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+namespace {
+
+using dynvo::test::FlowRegion;
+using dynvo::test::makeMotion;
+
+constexpr int CELL = 4;
+
+template <typename PointT> class RigidMotionSegmentationTyped : public ::testing::Test {
+};
+using PointTypes = ::testing::Types<pcl::PointXYZRGB, pcl::PointXYZRGBA>;
+TYPED_TEST_SUITE(RigidMotionSegmentationTyped, PointTypes);
+
+TYPED_TEST(RigidMotionSegmentationTyped, KnownMotionsGivePixelSegments)
+{
+  const Eigen::Matrix4d T_camera = makeMotion({0, 1, 0}, 0.01, {0.01, 0.0, -0.02});
+  const Eigen::Matrix4d T_object = makeMotion({0, 0, 1}, 0.05, {0.04, 0.01, 0.0});
+  const auto synthetic =
+      dynvo::test::makeSyntheticFlow(40, 30, CELL, dynvo::test::intrinsicsFor(160),
+                                     T_camera, {{4, 6, 14, 16, 1.2, T_object, 2}});
+  const auto cloud = dynvo::test::cloudFromFlow<TypeParam>(*synthetic.flow, CELL);
+
+  dynvo::RigidMotionSegmentation<TypeParam> segmentation;
+  segmentation.setCellSize(CELL);
+  segmentation.setTracking(false);
+  segmentation.setInputCloud(cloud);
+  segmentation.setInputFlow(synthetic.flow);
+  std::vector<pcl::PointIndices> segments;
+  segmentation.segment(segments);
+  ASSERT_EQ(segments.size(), 2u);
+  ASSERT_EQ(segmentation.getMotions().size(), 2u);
+  EXPECT_EQ(segmentation.getSegmentLabels(), (std::vector<std::uint8_t>{1, 2}));
+  // Pixel indices: every finite pixel of the segment's cells, ascending, nothing else.
+  const std::vector<std::uint8_t>& cells = segmentation.getCellLabels();
+  for (std::size_t s = 0; s < segments.size(); ++s) {
+    std::size_t expected = 0;
+    for (std::size_t i = 0; i < cloud->size(); ++i) {
+      const std::size_t cell =
+          (i / cloud->width / CELL) * 40 + (i % cloud->width) / CELL;
+      expected += cells[cell] == s + 1 && std::isfinite((*cloud)[i].z);
+    }
+    EXPECT_EQ(segments[s].indices.size(), expected);
+    EXPECT_TRUE(std::is_sorted(segments[s].indices.begin(), segments[s].indices.end()));
+    for (const int index : segments[s].indices)
+      EXPECT_TRUE(std::isfinite((*cloud)[index].z));
+  }
+  // The object's box: 10 x 10 cells of 16 px, one in seven pixels without depth.
+  EXPECT_NEAR(static_cast<double>(segments[1].indices.size()), 1600.0 * 6.0 / 7.0, 2.0);
+  const Eigen::Matrix4d motion = segmentation.getMotions()[1].template cast<double>();
+  // Float storage of the motion: 1e-6 relative, far below the 1 mm / 0.1 deg tolerances.
+  EXPECT_LT(dynvo::test::translationDifference(motion, T_object), 1e-3);
+  EXPECT_LT(dynvo::test::rotationDifferenceDeg(motion, T_object), 0.1);
+}
+
+TYPED_TEST(RigidMotionSegmentationTyped, SameFrameTwiceGivesOneStaticSegment)
+{
+  const auto synthetic = dynvo::test::makeSyntheticFlow(
+      40, 30, CELL, dynvo::test::intrinsicsFor(160), Eigen::Matrix4d::Identity(), {});
+  dynvo::RigidMotionSegmentation<TypeParam> segmentation;
+  segmentation.setCellSize(CELL);
+  segmentation.setTracking(false);
+  segmentation.setInputCloud(
+      dynvo::test::cloudFromFlow<TypeParam>(*synthetic.flow, CELL));
+  segmentation.setInputFlow(synthetic.flow);
+  std::vector<pcl::PointIndices> segments;
+  segmentation.segment(segments);
+  ASSERT_EQ(segments.size(), 1u);
+  EXPECT_EQ(segments[0].indices.size(), 160u * 120u - (160u * 120u + 6u) / 7u);
+  // Zero flow: the fit returns identity up to float rounding of the points.
+  EXPECT_TRUE(segmentation.getMotions()[0].isIdentity(1e-5f));
+}
+
+TEST(RigidMotionSegmentationDeterminism, SameSeedSameOutputForOneAndTwoThreads)
+{
+  const Eigen::Matrix4d T_object = makeMotion({0, 1, 1}, 0.04, {0.02, 0.0, 0.03});
+  const auto synthetic = dynvo::test::makeSyntheticFlow(
+      40, 30, CELL, dynvo::test::intrinsicsFor(160), Eigen::Matrix4d::Identity(),
+      {{20, 5, 32, 15, 1.1, T_object, 2}}, 0.002, 9);
+  const auto cloud =
+      dynvo::test::cloudFromFlow<pcl::PointXYZRGB>(*synthetic.flow, CELL);
+  const auto run = [&](unsigned threads) {
+    dynvo::RigidMotionSegmentation<pcl::PointXYZRGB> segmentation;
+    segmentation.setCellSize(CELL);
+    segmentation.setSeed(7);
+    segmentation.setNumberOfThreads(threads);
+    segmentation.setInputCloud(cloud);
+    segmentation.setInputFlow(synthetic.flow);
+    std::vector<pcl::PointIndices> segments;
+    segmentation.segment(segments);
+    return std::make_pair(segments, segmentation.getMotions());
+  };
+  const auto one = run(1);
+  const auto two = run(2);
+  ASSERT_EQ(one.first.size(), two.first.size());
+  for (std::size_t s = 0; s < one.first.size(); ++s)
+    EXPECT_EQ(one.first[s].indices, two.first[s].indices);
+  for (std::size_t s = 0; s < one.second.size(); ++s)
+    EXPECT_TRUE(one.second[s] == two.second[s]); // bit-identical
+}
+
+TEST(RigidMotionSegmentationContract, BadInputsClearOutputs)
+{
+  using Segmentation = dynvo::RigidMotionSegmentation<pcl::PointXYZRGB>;
+  const auto synthetic = dynvo::test::makeSyntheticFlow(
+      40, 30, CELL, dynvo::test::intrinsicsFor(160), Eigen::Matrix4d::Identity(), {});
+  const auto cloud =
+      dynvo::test::cloudFromFlow<pcl::PointXYZRGB>(*synthetic.flow, CELL);
+  std::vector<pcl::PointIndices> segments(3);
+
+  Segmentation no_inputs;
+  no_inputs.segment(segments);
+  EXPECT_TRUE(segments.empty());
+
+  Segmentation no_flow;
+  no_flow.setCellSize(CELL);
+  no_flow.setInputCloud(cloud);
+  segments.resize(2);
+  no_flow.segment(segments);
+  EXPECT_TRUE(segments.empty());
+
+  // A flow grid that belongs to 16 px cells does not fit 4 px cells of this cloud.
+  Segmentation mismatched;
+  mismatched.setInputCloud(cloud);
+  mismatched.setInputFlow(synthetic.flow);
+  segments.resize(2);
+  mismatched.segment(segments);
+  EXPECT_TRUE(segments.empty());
+  EXPECT_TRUE(mismatched.getCellLabels().empty());
+  EXPECT_TRUE(mismatched.getMotions().empty());
+
+  Segmentation unorganized;
+  unorganized.setCellSize(CELL);
+  pcl::PointCloud<pcl::PointXYZRGB>::Ptr flat(
+      new pcl::PointCloud<pcl::PointXYZRGB>(*cloud));
+  flat->width = static_cast<std::uint32_t>(flat->size());
+  flat->height = 1;
+  unorganized.setInputCloud(flat);
+  unorganized.setInputFlow(synthetic.flow);
+  segments.resize(2);
+  unorganized.segment(segments);
+  EXPECT_TRUE(segments.empty());
+}
+
+TEST(RigidMotionSegmentationContract, VgaFrameWithDefaultCells)
+{
+  // 640 x 480 with the default 16 px cells: 40 x 30 grid.
+  const Eigen::Matrix4d T_object = makeMotion({1, 0, 0}, 0.03, {0.0, 0.03, 0.02});
+  const auto synthetic = dynvo::test::makeSyntheticFlow(
+      40, 30, 16, dynvo::test::intrinsicsFor(640), Eigen::Matrix4d::Identity(),
+      {{20, 10, 30, 20, 1.4, T_object, 2}});
+  dynvo::RigidMotionSegmentation<pcl::PointXYZRGBA> segmentation;
+  segmentation.setInputCloud(
+      dynvo::test::cloudFromFlow<pcl::PointXYZRGBA>(*synthetic.flow, 16));
+  segmentation.setInputFlow(synthetic.flow);
+  std::vector<pcl::PointIndices> segments;
+  segmentation.segment(segments);
+  ASSERT_EQ(segments.size(), 2u);
+  EXPECT_EQ(dynvo::test::cellIoU(segmentation.getCellLabels(), std::uint8_t{2},
+                                 synthetic.truth, 2),
+            1.0);
+}
+
+TEST(RigidMotionSegmentationContract, BadParametersThrow)
+{
+  dynvo::RigidMotionSegmentation<pcl::PointXYZRGB> segmentation;
+  EXPECT_THROW(segmentation.setCellSize(1), std::invalid_argument);
+  EXPECT_THROW(segmentation.setInlierThreshold(0.0f), std::invalid_argument);
+  EXPECT_THROW(segmentation.setSampleSize(2), std::invalid_argument);
+  EXPECT_THROW(segmentation.setMaxHypotheses(0), std::invalid_argument);
+  EXPECT_THROW(segmentation.setMaxTrials(5), std::invalid_argument); // < max_hypotheses
+  EXPECT_THROW(segmentation.setDbscanEpsilon(-1.0f), std::invalid_argument);
+  EXPECT_THROW(segmentation.setMaxLabels(255), std::invalid_argument);
+  EXPECT_THROW(segmentation.setMinCorrelation(0.0f), std::invalid_argument);
+  EXPECT_THROW(segmentation.setNumberOfThreads(0), std::invalid_argument);
+  dynvo::CameraIntrinsics bad;
+  bad.fx = 0.0;
+  EXPECT_THROW(segmentation.setCameraIntrinsics(bad), std::invalid_argument);
+  Eigen::Matrix4f nan_motion = Eigen::Matrix4f::Identity();
+  nan_motion(0, 3) = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_THROW(segmentation.setPredictedMotion(nan_motion), std::invalid_argument);
+  // A failed setter keeps the previous value.
+  EXPECT_EQ(segmentation.getCellSize(), 16);
+  EXPECT_FLOAT_EQ(segmentation.getInlierThreshold(),
+                  dynvo::RigidMotionSegmentationParameters{}.inlier_threshold);
+}
+
+} // namespace

@@ -1,0 +1,270 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Dual-mode model, compensation, matching and tracking (ALGORITHM.md §4-§6).
+#include <dynvo/motion_segmentation/dual_label_model.h>
+#include <dynvo/motion_segmentation/rigid_motion_segmentation.h>
+#include <dynvo/motion_segmentation/segment_tracker.h>
+
+#include "synthetic_flow.h"
+
+#include <pcl/point_types.h>
+
+#include <gtest/gtest.h>
+
+#include <numeric>
+#include <random>
+#include <vector>
+
+namespace {
+
+using Model = dynvo::DualLabelModel::Model;
+constexpr float MAX_AGE = 5.0f;
+
+/// Source pixels of the identity warp (every cell onto itself), 16 px cells.
+std::vector<Eigen::Vector2f>
+identitySources(int cols, int rows, Eigen::Vector2f shift = Eigen::Vector2f::Zero())
+{
+  std::vector<Eigen::Vector2f> sources;
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c)
+      sources.emplace_back(Eigen::Vector2f(16.0f * c + 8.0f, 16.0f * r + 8.0f) + shift);
+  return sources;
+}
+
+/// One frame on a single-cell model: identity compensation then update with `g`.
+void
+step(dynvo::DualLabelModel& model, std::uint8_t g)
+{
+  model.compensate(identitySources(1, 1), {1}, 16);
+  model.update({g}, MAX_AGE);
+}
+
+TEST(DualLabelModel, StoppedObjectSwapsToStaticAfterMaxAgeFrames)
+{
+  dynvo::DualLabelModel model;
+  model.reset(1, 1, 3);
+  // An object (label 3) is seen for 7 frames: A = one-hot(3), age saturates at 5.
+  for (int k = 0; k < 7; ++k)
+    step(model, 3);
+  EXPECT_FLOAT_EQ(model.age(Model::apparent, 0), 5.0f);
+  EXPECT_FLOAT_EQ(model.probability(Model::apparent, 0, 3), 1.0f);
+  EXPECT_EQ(model.readOut()[0], 3);
+  // It stops: measured static (1). C grows 1, 2, 3, 4 while L stays 3 ...
+  for (int k = 1; k <= 4; ++k) {
+    step(model, 1);
+    EXPECT_FLOAT_EQ(model.age(Model::candidate, 0), static_cast<float>(k));
+    EXPECT_FLOAT_EQ(model.probability(Model::candidate, 0, 1), 1.0f);
+    EXPECT_EQ(model.readOut()[0], 3) << "frame " << k;
+  }
+  // ... and at the 5th frame C reaches alpha_max: swap, candidate reset, L = 1.
+  step(model, 1);
+  EXPECT_EQ(model.readOut()[0], 1);
+  EXPECT_FLOAT_EQ(model.age(Model::apparent, 0), 5.0f);
+  EXPECT_FLOAT_EQ(model.probability(Model::apparent, 0, 1), 1.0f);
+  EXPECT_FLOAT_EQ(model.age(Model::candidate, 0), 0.0f);
+  EXPECT_FLOAT_EQ(model.probability(Model::candidate, 0, 3), 0.0f);
+  // No measurement: nothing changes, L kept.
+  step(model, 0);
+  EXPECT_EQ(model.readOut()[0], 1);
+  EXPECT_FLOAT_EQ(model.age(Model::apparent, 0), 5.0f);
+}
+
+TEST(DualLabelModel, YoungCandidateOvertakesYoungerApparent)
+{
+  dynvo::DualLabelModel model;
+  model.reset(1, 1, 3);
+  step(model, 1); // A = one-hot(1), age 1
+  step(model, 2); // C = one-hot(2), age 1: not older than A
+  EXPECT_EQ(model.readOut()[0], 1);
+  EXPECT_FLOAT_EQ(model.age(Model::candidate, 0), 1.0f);
+  step(model, 2); // C age 2 > A age 1: swap
+  EXPECT_EQ(model.readOut()[0], 2);
+  EXPECT_FLOAT_EQ(model.age(Model::apparent, 0), 2.0f);
+  EXPECT_FLOAT_EQ(model.age(Model::candidate, 0), 0.0f);
+}
+
+TEST(DualLabelModel, CompensatedModelIsUpdatedAsRunningAverage)
+{
+  dynvo::DualLabelModel model;
+  model.reset(2, 1, 3);
+  model.setModel(Model::apparent, 0, {1, 0, 0}, 2.0f);
+  model.setModel(Model::apparent, 1, {0, 1, 0}, 4.0f);
+  // Cell 0 takes its square from 4 px to the right: 3/4 of cell 0, 1/4 of cell 1.
+  // Cell 1's source square lies 3/4 outside the grid: only cell 1 is left (weight 1).
+  model.compensate(identitySources(2, 1, {4.0f, 0.0f}), {1, 1}, 16);
+  EXPECT_FLOAT_EQ(model.age(Model::apparent, 0), 0.75f * 2.0f + 0.25f * 4.0f);
+  EXPECT_FLOAT_EQ(model.probability(Model::apparent, 0, 1), 0.75f);
+  EXPECT_FLOAT_EQ(model.probability(Model::apparent, 0, 2), 0.25f);
+  EXPECT_FLOAT_EQ(model.age(Model::apparent, 1), 4.0f);
+  // Measurement 1 = argmax: P = (2.5 P~ + e1) / 3.5, age 3.5.
+  model.update({1, 0}, MAX_AGE);
+  EXPECT_FLOAT_EQ(model.probability(Model::apparent, 0, 1),
+                  (2.5f * 0.75f + 1.0f) / 3.5f);
+  EXPECT_FLOAT_EQ(model.probability(Model::apparent, 0, 2), 2.5f * 0.25f / 3.5f);
+  EXPECT_FLOAT_EQ(model.age(Model::apparent, 0), 3.5f);
+  EXPECT_EQ(model.readOut()[0], 1);
+}
+
+TEST(DualLabelModel, SubCellShiftGivesBilinearWeights)
+{
+  // 4 x 3 grid; previous cell j has age j + 1 and P = one-hot(j % 4 + 1) in A.
+  constexpr int COLS = 4, ROWS = 3;
+  dynvo::DualLabelModel model;
+  model.reset(COLS, ROWS, 4);
+  for (int j = 0; j < COLS * ROWS; ++j) {
+    std::vector<float> p(4, 0.0f);
+    p[j % 4] = 1.0f;
+    model.setModel(Model::apparent, j, p, static_cast<float>(j + 1));
+  }
+  // Shift by (4, 8) px = (1/4, 1/2) cell: weights (1-fu)(1-fv) = 3/8, fu(1-fv) = 1/8,
+  // (1-fu)fv = 3/8, fu fv = 1/8 on cells (a, b), (a+1, b), (a, b+1), (a+1, b+1).
+  model.compensate(identitySources(COLS, ROWS, {4.0f, 8.0f}),
+                   std::vector<std::uint8_t>(12, 1), 16);
+  const auto age = [](int a, int b) {
+    return static_cast<float>(b * COLS + a + 1);
+  };
+  // Interior cell (1, 0): all four sources inside.
+  EXPECT_FLOAT_EQ(model.age(Model::apparent, 1),
+                  0.375f * age(1, 0) + 0.125f * age(2, 0) + 0.375f * age(1, 1) +
+                      0.125f * age(2, 1));
+  // Labels: cell (1,0) -> label 2, (2,0) -> 3, (1,1) -> 2 (index 5 % 4 + 1), (2,1) -> 3.
+  EXPECT_FLOAT_EQ(model.probability(Model::apparent, 1, 2), 0.75f);
+  EXPECT_FLOAT_EQ(model.probability(Model::apparent, 1, 3), 0.25f);
+  // Last column (3, 0): the a+1 sources are outside; the rest renormalised to 1/2, 1/2.
+  EXPECT_FLOAT_EQ(model.age(Model::apparent, 3), 0.5f * age(3, 0) + 0.5f * age(3, 1));
+  // Last row (1, 2): the b+1 sources are outside; weights 3/4 and 1/4.
+  EXPECT_FLOAT_EQ(model.age(Model::apparent, 9), 0.75f * age(1, 2) + 0.25f * age(2, 2));
+}
+
+TEST(DualLabelModel, UninitialisedSourcesLowerAgeButKeepNormalisation)
+{
+  dynvo::DualLabelModel model;
+  model.reset(2, 1, 2);
+  model.setModel(Model::apparent, 0, {0, 1}, 4.0f); // cell 1 stays uninitialised
+  model.compensate(identitySources(2, 1, {8.0f, 0.0f}), {1, 1}, 16);
+  EXPECT_FLOAT_EQ(model.age(Model::apparent, 0), 2.0f); // 1/2 * 4 + 1/2 * 0
+  EXPECT_FLOAT_EQ(model.probability(Model::apparent, 0, 2),
+                  1.0f); // normalised over cell 0
+}
+
+TEST(DualLabelModel, ProbabilitiesStayNormalised)
+{
+  constexpr int COLS = 6, ROWS = 5, LABELS = 4;
+  dynvo::DualLabelModel model;
+  model.reset(COLS, ROWS, LABELS);
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<int> label(0, LABELS);
+  std::uniform_real_distribution<float> shift(-12.0f, 12.0f);
+  for (int k = 0; k < 40; ++k) {
+    model.compensate(identitySources(COLS, ROWS, {shift(rng), shift(rng)}),
+                     std::vector<std::uint8_t>(COLS * ROWS, 1), 16);
+    std::vector<std::uint8_t> measurement(COLS * ROWS);
+    for (auto& g : measurement)
+      g = static_cast<std::uint8_t>(label(rng));
+    model.update(measurement, MAX_AGE);
+    for (int i = 0; i < COLS * ROWS; ++i)
+      for (const Model m : {Model::apparent, Model::candidate}) {
+        float sum = 0.0f;
+        for (int l = 1; l <= LABELS; ++l)
+          sum += model.probability(m, i, l);
+        // A few dozen float multiply-adds per frame: rounding stays below 1e-5.
+        if (model.age(m, i) > 0.0f)
+          EXPECT_NEAR(sum, 1.0f, 1e-5f);
+        else
+          EXPECT_EQ(sum, 0.0f);
+      }
+  }
+}
+
+TEST(SegmentMatching, CorrelationByHand)
+{
+  const std::vector<std::uint8_t> segments = {1, 1, 1, 2, 2, 0};
+  const std::vector<std::uint8_t> past = {1, 1, 0, 3, 3, 3};
+  std::vector<double> C;
+  const double score = dynvo::correlateLabelMaps(segments, past, 2, 3, C);
+  // C_11 = 2 / sqrt(3 * 2), C_23 = 2 / sqrt(2 * 3); score = (3 C_11 + 2 C_23) / 5.
+  EXPECT_NEAR(C[1 * 4 + 1], 2.0 / std::sqrt(6.0), 1e-12);
+  EXPECT_NEAR(C[2 * 4 + 3], 2.0 / std::sqrt(6.0), 1e-12);
+  EXPECT_EQ(C[1 * 4 + 3], 0.0);
+  EXPECT_NEAR(score, 2.0 / std::sqrt(6.0), 1e-12);
+}
+
+/// A box translating 4 cm per frame to the right in front of a static background
+/// (160 x 120, 4 px cells), fed frame by frame to one RigidMotionSegmentation.
+class BoxSequence : public ::testing::Test {
+protected:
+  static constexpr int CELL = 4;
+
+  std::vector<pcl::PointIndices> frame(int k, int box_col0, int box_width)
+  {
+    const Eigen::Matrix4d T_box =
+        dynvo::test::makeMotion({0, 0, 1}, 0.0, {0.04, 0.0, 0.0});
+    const auto synthetic = dynvo::test::makeSyntheticFlow(
+        40, 30, CELL, dynvo::test::intrinsicsFor(160), Eigen::Matrix4d::Identity(),
+        {{box_col0 + k, 8, box_col0 + k + box_width, 22, 1.2, T_box, 2}});
+    truth = synthetic.truth;
+    segmentation.setInputCloud(
+        dynvo::test::cloudFromFlow<pcl::PointXYZRGB>(*synthetic.flow, CELL));
+    segmentation.setInputFlow(synthetic.flow);
+    std::vector<pcl::PointIndices> segments;
+    segmentation.segment(segments);
+    return segments;
+  }
+
+  void SetUp() override
+  {
+    segmentation.setCellSize(CELL);
+    segmentation.setCameraIntrinsics(dynvo::test::intrinsicsFor(160));
+  }
+
+  dynvo::RigidMotionSegmentation<pcl::PointXYZRGB> segmentation;
+  std::vector<int> truth;
+};
+
+TEST_F(BoxSequence, BoxKeepsOneIdAndBackgroundIsFirst)
+{
+  for (int k = 0; k < 8; ++k) {
+    const auto segments = frame(k, 4, 8);
+    ASSERT_EQ(segments.size(), 2u) << "frame " << k;
+    EXPECT_EQ(segmentation.getSegmentLabels(), (std::vector<std::uint8_t>{1, 2}));
+    // The measurement Ghat is the box; the output also keeps the cells the box has just
+    // left (the model holds them for up to alpha_max frames), so it covers the box.
+    EXPECT_GE(dynvo::test::cellIoU(segmentation.getTracker().trackedLabels(),
+                                   std::uint8_t{2}, truth, 2),
+              0.9);
+    for (std::size_t i = 0; i < truth.size(); ++i)
+      if (truth[i] == 2)
+        EXPECT_EQ(segmentation.getCellLabels()[i], 2);
+    // The box's motion: 4 cm along x (float storage, far below 1 mm).
+    EXPECT_NEAR(segmentation.getMotions()[1](0, 3), 0.04f, 1e-3f);
+  }
+  // reset() starts a new sequence: ids are given afresh (first-pair rule).
+  segmentation.reset();
+  EXPECT_EQ(frame(0, 20, 8).size(), 2u);
+  EXPECT_EQ(segmentation.getSegmentLabels(), (std::vector<std::uint8_t>{1, 2}));
+  EXPECT_GE(
+      dynvo::test::cellIoU(segmentation.getCellLabels(), std::uint8_t{2}, truth, 2),
+      0.9);
+}
+
+TEST_F(BoxSequence, BoxCoveringMostOfTheImageDoesNotTakeTheBackgroundLabel)
+{
+  // The box covers 28 of 40 columns over the full height: 840 of 1200 cells.
+  const Eigen::Matrix4d T_box =
+      dynvo::test::makeMotion({0, 0, 1}, 0.0, {0.04, 0.0, 0.0});
+  const auto synthetic = dynvo::test::makeSyntheticFlow(
+      40, 30, CELL, dynvo::test::intrinsicsFor(160), Eigen::Matrix4d::Identity(),
+      {{2, 0, 30, 30, 1.2, T_box, 2}});
+  segmentation.setInputCloud(
+      dynvo::test::cloudFromFlow<pcl::PointXYZRGB>(*synthetic.flow, CELL));
+  segmentation.setInputFlow(synthetic.flow);
+  std::vector<pcl::PointIndices> segments;
+  segmentation.segment(segments); // H_pred = identity: the static camera's prediction
+  ASSERT_EQ(segments.size(), 2u);
+  // The box (840 cells) is the largest segment, but the background agrees with H_pred.
+  EXPECT_EQ(dynvo::test::cellIoU(segmentation.getCellLabels(), std::uint8_t{1},
+                                 synthetic.truth, 1),
+            1.0);
+  EXPECT_TRUE(segmentation.getMotions()[0].isIdentity(1e-4f));
+}
+
+} // namespace

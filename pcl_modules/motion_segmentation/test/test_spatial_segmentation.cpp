@@ -1,0 +1,215 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Two-frame rigid motion segmentation (ALGORITHM.md §3) on synthetic flow grids.
+#include <dynvo/motion_segmentation/spatial_segmentation.h>
+
+#include "synthetic_flow.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <vector>
+
+namespace {
+
+using dynvo::test::FlowRegion;
+using dynvo::test::makeMotion;
+
+constexpr int COLS = 40; // 1200 cells, as VGA with 16 px cells
+constexpr int ROWS = 30;
+constexpr int CELL = 4; // 160 x 120 image
+
+dynvo::CameraIntrinsics
+smallIntrinsics()
+{
+  dynvo::CameraIntrinsics K; // the "default" preset scaled to 160 x 120
+  K.fx = K.fy = 525.0 / 4.0;
+  K.cx = 79.5;
+  K.cy = 59.5;
+  return K;
+}
+
+dynvo::SpatialSegmentationResult
+segmentFlow(const dynvo::test::SyntheticFlow& synthetic,
+            const dynvo::RigidMotionSegmentationParameters& params = {})
+{
+  dynvo::GridFlowData grid;
+  grid.assign(*synthetic.flow, CELL);
+  dynvo::SpatialSegmenter segmenter;
+  dynvo::SpatialSegmentationResult result;
+  segmenter.segment(grid, params, result);
+  return result;
+}
+
+/// Segment (1..g) with the largest cell IoU against region `id`, and that IoU.
+std::pair<int, double>
+bestSegment(const dynvo::SpatialSegmentationResult& result,
+            const std::vector<int>& truth,
+            int id)
+{
+  std::pair<int, double> best{0, 0.0};
+  for (int c = 1; c <= result.segmentCount(); ++c) {
+    const double iou =
+        dynvo::test::cellIoU(result.labels, static_cast<std::uint8_t>(c), truth, id);
+    if (iou > best.second)
+      best = {c, iou};
+  }
+  return best;
+}
+
+/// Camera moving forward and panning, plus two boxes with their own motions.
+struct TwoObjects {
+  Eigen::Matrix4d T_background = makeMotion({0, 1, 0}, 0.01, {0.01, 0.0, -0.02});
+  std::vector<FlowRegion> regions;
+  TwoObjects()
+  {
+    FlowRegion box1{4, 6, 14, 16, 1.2, makeMotion({0, 0, 1}, 0.05, {0.04, 0.01, 0.0}),
+                    2};
+    FlowRegion box2{
+        24, 12, 34, 24, 1.6, makeMotion({1, 1, 0}, 0.03, {-0.03, 0.0, 0.02}), 3};
+    regions = {box1, box2};
+  }
+};
+
+TEST(SpatialSegmentation, TwoRigidMotionsAndBackgroundAreRecovered)
+{
+  const TwoObjects scene;
+  const auto synthetic = dynvo::test::makeSyntheticFlow(
+      COLS, ROWS, CELL, smallIntrinsics(), scene.T_background, scene.regions);
+  const dynvo::SpatialSegmentationResult result = segmentFlow(synthetic);
+  ASSERT_EQ(result.segmentCount(), 3);
+  const std::vector<Eigen::Matrix4d> truth_motions = {
+      scene.T_background, scene.regions[0].T_curr_prev, scene.regions[1].T_curr_prev};
+  for (int id = 1; id <= 3; ++id) {
+    const auto [segment, iou] = bestSegment(result, synthetic.truth, id);
+    SCOPED_TRACE("region " + std::to_string(id));
+    EXPECT_GE(iou, 0.9);
+    ASSERT_GT(segment, 0);
+    // Noise-free input: the fit is exact up to float rounding of the points (~1e-7 m at 3 m).
+    const Eigen::Matrix4d& H = result.motions[segment - 1];
+    EXPECT_LT(dynvo::test::translationDifference(H, truth_motions[id - 1]), 1e-3);
+    EXPECT_LT(dynvo::test::rotationDifferenceDeg(H, truth_motions[id - 1]), 0.1);
+  }
+  // The background is the largest segment.
+  EXPECT_EQ(bestSegment(result, synthetic.truth, 1).first, 1);
+}
+
+TEST(SpatialSegmentation, OneObjectSeenInTwoRegionsIsOneSegment)
+{
+  const Eigen::Matrix4d T_object = makeMotion({0, 0, 1}, 0.04, {0.03, -0.02, 0.01});
+  // Two disjoint patches of the same rigid object (e.g. split by an occluder).
+  const std::vector<FlowRegion> regions = {{3, 4, 11, 12, 1.3, T_object, 2},
+                                           {28, 16, 37, 26, 1.3, T_object, 2}};
+  const auto synthetic = dynvo::test::makeSyntheticFlow(
+      COLS, ROWS, CELL, smallIntrinsics(), Eigen::Matrix4d::Identity(), regions);
+  const dynvo::SpatialSegmentationResult result = segmentFlow(synthetic);
+  ASSERT_EQ(result.segmentCount(), 2);
+  EXPECT_GE(bestSegment(result, synthetic.truth, 2).second, 0.9);
+}
+
+TEST(SpatialSegmentation, PureNoiseFlowGivesNoLargeSegment)
+{
+  // Every cell gets its own random 3 cm displacement: no 7 neighbours share a rigid motion
+  // within the 5.5 mm inlier radius.
+  const auto synthetic = dynvo::test::makeSyntheticFlow(
+      COLS, ROWS, CELL, smallIntrinsics(), Eigen::Matrix4d::Identity(), {}, 0.03, 7);
+  const dynvo::RigidMotionSegmentationParameters params;
+  const dynvo::SpatialSegmentationResult result = segmentFlow(synthetic, params);
+  for (const int size : result.sizes)
+    EXPECT_LE(size, params.min_segment_size);
+}
+
+TEST(SpatialSegmentation, StaticFlowGivesOneSegment)
+{
+  const Eigen::Matrix4d T_camera = makeMotion({1, 0, 0}, 0.02, {0.0, 0.01, 0.03});
+  for (const double sigma : {0.0, 0.001}) {
+    SCOPED_TRACE("noise sigma " + std::to_string(sigma));
+    const auto synthetic = dynvo::test::makeSyntheticFlow(
+        COLS, ROWS, CELL, smallIntrinsics(), T_camera, {}, sigma, 3);
+    const dynvo::SpatialSegmentationResult result = segmentFlow(synthetic);
+    ASSERT_EQ(result.segmentCount(), 1);
+    // 1 mm noise per axis: |noise|^2 ~ 3e-6 m^2, 10 sigma under th_inlier = 3e-5, so every
+    // cell is an inlier.
+    EXPECT_EQ(result.sizes[0], COLS * ROWS);
+    EXPECT_LT(dynvo::test::translationDifference(result.motions[0], T_camera), 1e-3);
+  }
+}
+
+TEST(SpatialSegmentation, TooFewValidCellsGiveNoSegment)
+{
+  auto synthetic = dynvo::test::makeSyntheticFlow(COLS, ROWS, CELL, smallIntrinsics(),
+                                                  Eigen::Matrix4d::Identity(), {});
+  const dynvo::RigidMotionSegmentationParameters params;
+  // Keep 2 m - 1 valid cells: below the 2 m of ALGORITHM.md §3.
+  for (std::size_t i = 2 * params.sample_size - 1; i < synthetic.flow->size(); ++i)
+    (*synthetic.flow)[i].valid_3d = 0;
+  const dynvo::SpatialSegmentationResult result = segmentFlow(synthetic, params);
+  EXPECT_EQ(result.segmentCount(), 0);
+  EXPECT_EQ(std::count(result.labels.begin(), result.labels.end(), 0),
+            static_cast<long>(COLS * ROWS));
+}
+
+TEST(SpatialSegmentation, SameSeedSameResult)
+{
+  const TwoObjects scene;
+  const auto synthetic = dynvo::test::makeSyntheticFlow(
+      COLS, ROWS, CELL, smallIntrinsics(), scene.T_background, scene.regions, 0.002, 5);
+  dynvo::RigidMotionSegmentationParameters params;
+  params.seed = 42;
+  const auto one = segmentFlow(synthetic, params);
+  const auto again = segmentFlow(synthetic, params);
+  EXPECT_EQ(one.labels, again.labels);
+  EXPECT_EQ(one.trials, again.trials);
+  ASSERT_EQ(one.motions.size(), again.motions.size());
+  for (std::size_t c = 0; c < one.motions.size(); ++c)
+    EXPECT_TRUE(one.motions[c] == again.motions[c]); // bit-identical
+}
+
+TEST(SpatialSegmentation, MotionFieldDistanceOfTwoTranslations)
+{
+  // Two pure translations 4 mm apart move every point 4 mm apart.
+  const std::vector<Eigen::Vector3f> a = {{0, 0, 1}, {1, 0, 2}, {0, 1, 3}};
+  dynvo::MotionHypothesis x, y;
+  x.T_curr_prev = makeMotion({0, 0, 1}, 0.0, {0.01, 0.0, 0.0});
+  y.T_curr_prev = makeMotion({0, 0, 1}, 0.0, {0.01, 0.004, 0.0});
+  x.inliers = {0, 1};
+  y.inliers = {1, 2};
+  EXPECT_NEAR(dynvo::motionFieldDistance(x, y, a), 0.004, 1e-12);
+  // A rotation by 0.01 rad about the optical axis moves the points of the union {0, 2}
+  // by 0.01 * |(x, y)|, i.e. by 0 and 0.01 m: RMS = sqrt((0 + 1e-4) / 2).
+  y.T_curr_prev = makeMotion({0, 0, 1}, 0.01, {0.01, 0.0, 0.0});
+  x.inliers = {0};
+  y.inliers = {2};
+  EXPECT_NEAR(dynvo::motionFieldDistance(x, y, a), std::sqrt(1e-4 / 2.0), 1e-6);
+}
+
+/// Distance matrix of items on a line at the given positions.
+std::vector<double>
+lineDistances(const std::vector<double>& positions)
+{
+  const std::size_t n = positions.size();
+  std::vector<double> d(n * n);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = 0; j < n; ++j)
+      d[i * n + j] = std::abs(positions[i] - positions[j]);
+  return d;
+}
+
+TEST(Dbscan, MinPointsOneGivesConnectedComponents)
+{
+  // Chain 0-1-2 (steps of 4 <= eps 5), isolated 3, pair 4-5; 0 and 2 are 8 apart but linked.
+  const std::vector<double> positions = {0, 4, 8, 30, 60, 63};
+  const std::vector<int> clusters = dynvo::dbscan(lineDistances(positions), 6, 5.0, 1);
+  EXPECT_EQ(clusters, (std::vector<int>{0, 0, 0, 1, 2, 2}));
+}
+
+TEST(Dbscan, MinPointsMarksNoiseAndBorderPoints)
+{
+  // With min_points 3, only item 1 (neighbours 0, 1, 2) is core; 0 and 2 are border points
+  // of its cluster; 3, 4 and 5 are noise.
+  const std::vector<double> positions = {0, 4, 8, 30, 60, 63};
+  const std::vector<int> clusters = dynvo::dbscan(lineDistances(positions), 6, 5.0, 3);
+  EXPECT_EQ(clusters, (std::vector<int>{0, 0, 0, -1, -1, -1}));
+  EXPECT_TRUE(dynvo::dbscan({}, 0, 1.0, 1).empty());
+}
+
+} // namespace
