@@ -2,16 +2,15 @@
 // dynvo_segment: per-pixel rigid-motion labels of an RGB-D sequence (scene flow + segmentation).
 #include <dynvo/app/cli.h>
 #include <dynvo/app/frame_source_args.h>
+#include <dynvo/io/label_io.h>
 #include <dynvo/motion_segmentation/rigid_motion_segmentation.h>
 #include <dynvo/scene_flow/grid_scene_flow_estimation.h>
 
 #include <pcl/console/print.h>
 #include <pcl/console/time.h>
+#include <pcl/exceptions.h>
 #include <pcl/point_types.h>
 
-#include <Eigen/Geometry>
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
 #include <cstdio>
@@ -28,22 +27,6 @@ const char* const USAGE =
     "[-no_tracking] [-max_frames N] [-objects FILE] [-threads N] [-seed S]";
 
 using Point = pcl::PointXYZRGB;
-
-/// Writes the label image: 0 no measurement, 1 static, 2.. objects (uint8 PNG).
-void
-writeLabels(const std::string& path,
-            const pcl::PointCloud<Point>& cloud,
-            const std::vector<pcl::PointIndices>& segments,
-            const std::vector<std::uint8_t>& labels)
-{
-  cv::Mat image(static_cast<int>(cloud.height), static_cast<int>(cloud.width), CV_8UC1,
-                cv::Scalar(0));
-  for (std::size_t s = 0; s < segments.size(); ++s)
-    for (const int index : segments[s].indices)
-      image.data[index] = labels[s];
-  if (!cv::imwrite(path, image))
-    throw std::runtime_error("cannot write " + path);
-}
 
 } // namespace
 
@@ -100,7 +83,7 @@ main(int argc, char** argv)
     if (args.has("objects")) {
       objects.open(args.string("objects"));
       if (!objects)
-        throw std::runtime_error("cannot write " + args.string("objects"));
+        throw pcl::IOException(args.string("objects") + ": cannot write objects file");
     }
 
     dynvo::GridSceneFlowEstimation<Point> flow_estimation;
@@ -122,10 +105,11 @@ main(int argc, char** argv)
     for (; (max_frames < 0 || count < max_frames) && source->next(frame); ++count) {
       flow_estimation.shiftCurrentToPrevious();
       flow_estimation.setInputCloud(frame.cloud);
-      char name[64];
-      std::snprintf(name, sizeof(name), "%.6f.png", frame.timestamp);
+      const std::string path = (out_dir / dynvo::labelFileName(frame.timestamp)).string();
       if (count == 0) {
-        writeLabels((out_dir / name).string(), *frame.cloud, {}, {});
+        dynvo::writeLabelImage(path,
+                               dynvo::paintLabelImage({}, {}, frame.cloud->width,
+                                                      frame.cloud->height));
         continue;
       }
       flow_estimation.compute(*flow);
@@ -134,27 +118,20 @@ main(int argc, char** argv)
       timer.tic();
       segmentation.segment(segments);
       segment_ms += timer.toc();
-      writeLabels((out_dir / name).string(), *frame.cloud, segments,
-                  segmentation.getSegmentLabels());
+      dynvo::writeLabelImage(path,
+                             dynvo::paintLabelImage(segments, segmentation.getSegmentLabels(),
+                                                    frame.cloud->width, frame.cloud->height));
       if (segments.empty())
         continue;
       // Constant-velocity prediction for the next frame (identity until a background exists).
       if (!segments[0].indices.empty())
         segmentation.setPredictedMotion(segmentation.getMotions()[0]);
-      for (std::size_t s = 1; s < segments.size() && objects; ++s) {
-        const Eigen::Matrix4f& T = segmentation.getMotions()[s];
-        Eigen::Quaternionf q(T.topLeftCorner<3, 3>());
-        q.normalize();
-        if (q.w() < 0.0f)
-          q.coeffs() = -q.coeffs();
-        char line[256];
-        std::snprintf(line, sizeof(line),
-                      "%.6f %d %zu %.6f %.6f %.6f %.6f %.6f %.6f %.6f\n",
-                      frame.timestamp, segmentation.getSegmentLabels()[s],
-                      segments[s].indices.size(), T(0, 3), T(1, 3), T(2, 3), q.x(),
-                      q.y(), q.z(), q.w());
-        objects << line;
-      }
+      for (std::size_t s = 1; s < segments.size() && objects; ++s)
+        objects << dynvo::formatObjectMotionLine(frame.timestamp,
+                                                 segmentation.getSegmentLabels()[s],
+                                                 segments[s].indices.size(),
+                                                 segmentation.getMotions()[s])
+                << '\n';
     }
     pcl::console::print_highlight("Labelled %ld frames into %s; segmentation ", count,
                                   out_dir.string().c_str());

@@ -20,15 +20,6 @@ namespace fs = std::filesystem;
 using dynvo::test::runCommand;
 using dynvo::test::TempDir;
 
-std::string
-slurp(const std::string& path)
-{
-  std::ifstream in(path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 class OdometryApp : public ::testing::Test {
 protected:
   static void
@@ -94,7 +85,7 @@ TEST_F(OdometryApp, SameSeedSameBytesWithOneAndTwoThreads)
 {
   ASSERT_EQ(runCommand(run("-threads 1 -out " + out_.file("a.txt"))).exit_code, 0);
   ASSERT_EQ(runCommand(run("-threads 2 -out " + out_.file("b.txt"))).exit_code, 0);
-  EXPECT_EQ(slurp(out_.file("a.txt")), slurp(out_.file("b.txt")));
+  EXPECT_EQ(dynvo::test::readText(out_.file("a.txt")), dynvo::test::readText(out_.file("b.txt")));
 }
 
 TEST_F(OdometryApp, ConfigRoundTripsAndUnknownKeysAreRejected)

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <dynvo/app/odometry_pipeline.h>
-#include <dynvo/common/conventions.h>
+#include <dynvo/io/label_io.h>
 #include <dynvo/motion_segmentation/rigid_motion_segmentation.h>
 #include <dynvo/registration/static_scene_registration.h>
 #include <dynvo/scene_flow/grid_scene_flow_estimation.h>
@@ -128,15 +128,6 @@ struct OdometryPipeline::Impl {
     result.times.registration_ms = millisecondsSince(registration_start);
   }
 
-  void
-  paintLabels()
-  {
-    result.labels.assign(static_cast<std::size_t>(result.width) * result.height, LABEL_NONE);
-    for (std::size_t s = 0; s < result.segments.size(); ++s)
-      for (const auto index : result.segments[s].indices)
-        result.labels[index] = result.segment_labels[s];
-  }
-
   PipelineOptions options;
   GridSceneFlowEstimation<pcl::PointXYZRGB> flow_estimation;
   RigidMotionSegmentation<pcl::PointXYZRGB> segmentation;
@@ -185,7 +176,8 @@ OdometryPipeline::process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& clo
       orthonormalize(result.T_world_curr);
     p.T_curr_prev_predicted = result.T_curr_prev;
   }
-  p.paintLabels();
+  result.labels =
+      paintLabelImage(result.segments, result.segment_labels, result.width, result.height).data;
   p.T_world_prev = result.T_world_curr;
   p.previous = cloud;
   ++p.frames;

@@ -12,6 +12,19 @@
 
 namespace dynvo {
 
+LabelImage
+paintLabelImage(const std::vector<pcl::PointIndices>& segments,
+                const std::vector<std::uint8_t>& labels,
+                std::uint32_t width,
+                std::uint32_t height)
+{
+  LabelImage image{width, height, std::vector<std::uint8_t>(std::size_t{width} * height, 0)};
+  for (std::size_t s = 0; s < segments.size() && s < labels.size(); ++s)
+    for (const auto index : segments[s].indices)
+      image.data.at(index) = labels[s];
+  return image;
+}
+
 std::string
 labelFileName(double timestamp)
 {

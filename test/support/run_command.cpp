@@ -4,24 +4,9 @@
 
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
-#include <sstream>
 #include <sys/wait.h>
 
 namespace dynvo::test {
-
-namespace {
-
-std::string
-slurp(const std::string& path)
-{
-  std::ifstream in(path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-} // namespace
 
 CommandResult
 runCommand(const std::string& command)
@@ -34,8 +19,8 @@ runCommand(const std::string& command)
     result.exit_code = WEXITSTATUS(status);
   else if (WIFSIGNALED(status))
     result.exit_code = 128 + WTERMSIG(status);
-  result.out = slurp(out);
-  result.err = slurp(err);
+  result.out = readText(out);
+  result.err = readText(err);
   return result;
 }
 

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 #include <unistd.h>
 
@@ -38,6 +39,15 @@ writeText(const std::string& path, const std::string& text)
   if (!out)
     throw std::runtime_error("cannot write " + path);
   out << text;
+}
+
+std::string
+readText(const std::string& path)
+{
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
 }
 
 } // namespace dynvo::test

@@ -37,4 +37,8 @@ private:
 void
 writeText(const std::string& path, const std::string& text);
 
+/// The whole content of a file ("" when it cannot be read).
+std::string
+readText(const std::string& path);
+
 } // namespace dynvo::test

@@ -4,6 +4,8 @@
 
 #include <dynvo/common/export.h>
 
+#include <pcl/PointIndices.h>
+
 #include <Eigen/Core>
 
 #include <cstdint>
@@ -18,6 +20,15 @@ struct LabelImage {
   std::uint32_t height = 0;         ///< rows (px)
   std::vector<std::uint8_t> data;   ///< width * height labels, row-major
 };
+
+/** \brief Label image of a segmentation: the pixels of segments[s] get labels[s], every
+ * other pixel 0 (no measurement). Indices are linear pixel indices (row * width + col).
+ */
+DYNVO_EXPORTS LabelImage
+paintLabelImage(const std::vector<pcl::PointIndices>& segments,
+                const std::vector<std::uint8_t>& labels,
+                std::uint32_t width,
+                std::uint32_t height);
 
 /// File name of a frame's label image: "<timestamp %.6f>.png".
 DYNVO_EXPORTS std::string

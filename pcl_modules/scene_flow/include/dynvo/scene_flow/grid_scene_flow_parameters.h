@@ -19,7 +19,7 @@ enum class ForwardBackwardCheck {
  * The Lucas-Kanade defaults differ from ALGORITHM.md §1.2 (window 21, maxLevel 3, 30 iterations,
  * eps 0.01, backward track from scratch): those cost about 25 ms per VGA frame on one core of
  * the target machine (PLATFORM.md), against a budget of 8 ms for the whole stage. Window 13,
- * maxLevel 2, 10 iterations, eps 0.03 and the local check keep the synthetic end-point error at
+ * maxLevel 2, 8 iterations, eps 0.03 and the local check keep the synthetic end-point error at
  * about 0.1 px (VGA, 15-27 px of flow) and the share of valid cells on TUM fr1/xyz within 3
  * points of the ALGORITHM.md settings; the measurements are in pcl_modules/scene_flow/NOTES.md.
  */
@@ -34,7 +34,7 @@ struct DYNVO_EXPORTS GridSceneFlowParameters {
   /// LK levels (>= 0): OpenCV maxLevel, 0 = no pyramid (ALGORITHM.md: 3).
   int max_pyramid_level = 2;
   /// LK iters (>= 1): iteration cap per pyramid level (ALGORITHM.md: 30).
-  int max_iterations = 10;
+  int max_iterations = 8;
   /// LK eps (px, > 0): stop iterating when an update is shorter (ALGORITHM.md: 0.01).
   double epsilon = 0.03;
   /// OpenCV minEigThreshold (> 0): rejects textureless windows.
