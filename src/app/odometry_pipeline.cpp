@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <dynvo/app/odometry_pipeline.h>
+#include <dynvo/common/rigid_fit.h>
 #include <dynvo/io/label_io.h>
 #include <dynvo/motion_segmentation/rigid_motion_segmentation.h>
 #include <dynvo/registration/static_scene_registration.h>
@@ -67,6 +68,9 @@ PipelineOptions::validate() const
   registration.validate();
   if (threads == 0)
     throw std::invalid_argument("[dynvo::app::PipelineOptions] threads must be at least 1");
+  if (!(static_consensus >= 0.0f))
+    throw std::invalid_argument(
+        "[dynvo::app::PipelineOptions] static_consensus must be >= 0");
   if (segmentation.cell_size != scene_flow.cell_size)
     throw std::invalid_argument(
         "[dynvo::app::PipelineOptions] segmentation cell_size " +
@@ -117,15 +121,51 @@ struct OdometryPipeline::Impl {
     const auto registration_start = Clock::now();
     registration.setInputSource(cloud);
     registration.setInputTarget(previous);
-    registration.setIndices(static_indices);
     registration.setInputFlow(flow);
-    Cloud aligned;
-    registration.align(aligned, inverse(T_curr_prev_predicted).cast<float>());
+    // Static support: the segmentation's background gives a first estimate (or, when it
+    // fails, the constant-velocity prediction stands in); then every valid cell that moves
+    // like it counts as static, so background cells the noisy segmentation split off are
+    // used again while moving objects stay out.
+    const Eigen::Matrix4d T_prev_curr_predicted = inverse(T_curr_prev_predicted);
+    Eigen::Matrix4d T_prev_curr = T_prev_curr_predicted;
+    if (align(static_indices, T_prev_curr_predicted))
+      T_prev_curr = registration.getFinalTransformation().cast<double>();
+    if (options.use_segmentation && options.static_consensus > 0.0f)
+      align(consensusCells(*flow, cloud->width, T_prev_curr), T_prev_curr);
     result.lost = !registration.hasConverged();
     result.T_curr_prev = result.lost
                              ? T_curr_prev_predicted
                              : inverse(registration.getFinalTransformation().cast<double>());
     result.times.registration_ms = millisecondsSince(registration_start);
+  }
+
+  /// Registers on the given static pixels; true when it converged.
+  bool
+  align(const pcl::IndicesPtr& static_indices, const Eigen::Matrix4d& T_prev_curr_guess)
+  {
+    registration.setIndices(static_indices);
+    Cloud aligned;
+    registration.align(aligned, T_prev_curr_guess.cast<float>());
+    return registration.hasConverged();
+  }
+
+  /// Centre pixels of the valid cells whose flow agrees with T_prev_curr within
+  /// static_consensus * th_inlier (squared transfer error of b_i onto a_i).
+  pcl::IndicesPtr
+  consensusCells(const pcl::PointCloud<PointFlow>& flow,
+                 std::uint32_t image_width,
+                 const Eigen::Matrix4d& T_prev_curr) const
+  {
+    const double limit = options.static_consensus * options.registration.th_inlier;
+    auto indices = pcl::make_shared<pcl::Indices>();
+    for (const PointFlow& cell : flow)
+      if (cell.valid_3d &&
+          squaredTransferError(T_prev_curr, cell.getVector3fMap().cast<double>(),
+                               Eigen::Vector3d(cell.prev_x, cell.prev_y, cell.prev_z)) <=
+              limit)
+        indices->push_back(static_cast<int>(cell.v) * static_cast<int>(image_width) +
+                           static_cast<int>(cell.u));
+    return indices;
   }
 
   PipelineOptions options;

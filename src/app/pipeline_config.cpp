@@ -71,6 +71,7 @@ visitFields(Options& o, Visit&& visit)
         r.refinement_transformation_epsilon);
   visit("registration", "refinement_stride", r.refinement_stride);
   visit("pipeline", "use_segmentation", o.use_segmentation);
+  visit("pipeline", "static_consensus", o.static_consensus);
   visit("pipeline", "threads", o.threads);
 }
 

@@ -33,6 +33,10 @@ struct DYNVO_EXPORTS PipelineOptions {
   RigidMotionSegmentationParameters segmentation; ///< ALGORITHM.md §3-§6 (seed included)
   StaticSceneRegistrationParameters registration; ///< ALGORITHM.md §7
   bool use_segmentation = true; ///< false: ablation, every valid flow cell counts as static
+  /// Static support (multiple of registration.th_inlier, 0 = off): after a first fit on the
+  /// background segment, every valid cell whose flow agrees with it within this many
+  /// th_inlier (4: 11 mm) joins the static set for the final fit.
+  float static_consensus = 4.0f;
   unsigned threads = 1;         ///< worker threads; results do not depend on it
 
   /// \throws std::invalid_argument when a module's parameters or a pipeline value are invalid
