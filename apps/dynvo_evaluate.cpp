@@ -7,7 +7,8 @@
 
 namespace {
 
-const char* const USAGE = "dynvo_evaluate GROUNDTRUTH ESTIMATE [-delta D] [-delta_unit s|f] [-json]";
+const char* const USAGE =
+    "dynvo_evaluate GROUNDTRUTH ESTIMATE [-delta D] [-delta_unit s|f] [-json]";
 
 } // namespace
 
@@ -23,10 +24,11 @@ main(int argc, char** argv)
          {"json", "", "print the result as one JSON object"}},
         2);
     if (args.helpRequested()) {
-      std::printf("Usage: %s\n\nRelative pose error as TUM evaluate_rpe.py --fixed_delta "
-                  "and absolute trajectory error as evaluate_ate.py.\nBoth files are TUM "
-                  "trajectories (timestamp tx ty tz qx qy qz qw, camera-to-world).\n\n%s",
-                  USAGE, args.optionsHelp().c_str());
+      std::printf(
+          "Usage: %s\n\nRelative pose error as TUM evaluate_rpe.py --fixed_delta "
+          "and absolute trajectory error as evaluate_ate.py.\nBoth files are TUM "
+          "trajectories (timestamp tx ty tz qx qy qz qw, camera-to-world).\n\n%s",
+          USAGE, args.optionsHelp().c_str());
       return 0;
     }
     dynvo::RpeOptions options;

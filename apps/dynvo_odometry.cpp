@@ -34,23 +34,32 @@ std::vector<dynvo::app::Option>
 options()
 {
   auto list = dynvo::app::frameSourceOptions();
-  list.insert(list.end(), {
-      {"out", "FILE", "TUM trajectory to write (camera-to-world; first pose identity)"},
-      {"init_gt", "", "start from the first ground-truth pose (needs groundtruth.txt)"},
-      {"labels_dir", "DIR", "write <stamp>.png per frame: 0 none, 1 static, 2.. objects"},
-      {"objects", "FILE", "write 'timestamp id n_pixels tx ty tz qx qy qz qw' per object"},
-      {"max_frames", "N", "stop after N frames (default: all)"},
-      {"threads", "N", "worker threads (default 1); results do not depend on it"},
-      {"seed", "S", "hypothesis sampling seed (default 0)"},
-      {"no_segmentation", "", "ablation: every valid flow cell counts as static"},
-      {"refine", "none|icp|gicp", "refinement of the static registration (default none)"},
-      {"render_dir", "DIR", "render label-coloured views and trajectory.png (needs X: xvfb-run -a)"},
-      {"render_every", "N", "render every N-th frame (default 10)"},
-      {"config", "FILE", "YAML with every parameter (see -write_config)"},
-      {"write_config", "FILE", "write the effective configuration as YAML and exit"},
-      {"v", "", "verbose (PCL debug messages)"},
-      {"q", "", "quiet (errors only)"},
-  });
+  list.insert(
+      list.end(),
+      {
+          {"out", "FILE",
+           "TUM trajectory to write (camera-to-world; first pose identity)"},
+          {"init_gt", "",
+           "start from the first ground-truth pose (needs groundtruth.txt)"},
+          {"labels_dir", "DIR",
+           "write <stamp>.png per frame: 0 none, 1 static, 2.. objects"},
+          {"objects", "FILE",
+           "write 'timestamp id n_pixels tx ty tz qx qy qz qw' per object"},
+          {"max_frames", "N", "stop after N frames (default: all)"},
+          {"threads", "N", "worker threads (default 1); results do not depend on it"},
+          {"seed", "S", "hypothesis sampling seed (default 0)"},
+          {"no_segmentation", "", "ablation: every valid flow cell counts as static"},
+          {"refine", "none|icp|gicp",
+           "refinement of the static registration (default none)"},
+          {"render_dir", "DIR",
+           "render label-coloured views and trajectory.png (needs X: xvfb-run -a)"},
+          {"render_every", "N", "render every N-th frame (default 10)"},
+          {"config", "FILE", "YAML with every parameter (see -write_config)"},
+          {"write_config", "FILE",
+           "write the effective configuration as YAML and exit"},
+          {"v", "", "verbose (PCL debug messages)"},
+          {"q", "", "quiet (errors only)"},
+      });
   return list;
 }
 
@@ -85,8 +94,10 @@ pipelineOptions(const dynvo::app::Arguments& args)
 /// display the renderer warns once and the run carries on without images.
 class RunRenderer {
 public:
-  RunRenderer(const dynvo::app::Arguments& args, const dynvo::CameraIntrinsics& intrinsics)
-  : dir_(args.string("render_dir")), every_(args.integer("render_every", 10))
+  RunRenderer(const dynvo::app::Arguments& args,
+              const dynvo::CameraIntrinsics& intrinsics)
+      : dir_(args.string("render_dir"))
+      , every_(args.integer("render_every", 10))
   {
     if (every_ < 1)
       throw UsageError("-render_every must be >= 1");
@@ -101,9 +112,9 @@ public:
 #endif
   }
 
-  void
-  add(const dynvo::Frame& frame, const dynvo::app::FrameResult& result,
-      const dynvo::Trajectory& trajectory)
+  void add(const dynvo::Frame& frame,
+           const dynvo::app::FrameResult& result,
+           const dynvo::Trajectory& trajectory)
   {
 #ifdef DYNVO_WITH_VTK
     if (dir_.empty() || (trajectory.size() - 1) % every_ != 0)
@@ -111,23 +122,24 @@ public:
     params_.width = frame.cloud->width;
     params_.height = frame.cloud->height;
     renderer_.setParameters(params_);
-    const std::string name = fs::path(dynvo::labelFileName(frame.timestamp)).stem().string();
-    renderer_.render(*frame.cloud, result.labels, trajectory.back().T_world_camera, trajectory,
-                     (fs::path(dir_) / (name + "_camera.png")).string());
+    const std::string name =
+        fs::path(dynvo::labelFileName(frame.timestamp)).stem().string();
+    renderer_.render(*frame.cloud, result.labels, trajectory.back().T_world_camera,
+                     trajectory, (fs::path(dir_) / (name + "_camera.png")).string());
 #else
     (void)frame, (void)result, (void)trajectory;
 #endif
   }
 
-  void
-  finish(const dynvo::Trajectory& estimate, const dynvo::Trajectory& groundtruth)
+  void finish(const dynvo::Trajectory& estimate, const dynvo::Trajectory& groundtruth)
   {
 #ifdef DYNVO_WITH_VTK
     if (dir_.empty() || estimate.size() < 2)
       return;
     const std::string plot = (fs::path(dir_) / "trajectory.png").string();
-    const auto aligned =
-        groundtruth.empty() ? estimate : dynvo::alignToGroundTruth(groundtruth, estimate);
+    const auto aligned = groundtruth.empty()
+                             ? estimate
+                             : dynvo::alignToGroundTruth(groundtruth, estimate);
     if (dynvo::writeTrajectoryPlot(aligned, groundtruth, plot, {}))
       std::printf("rendered frames and %s\n", plot.c_str());
 #else
@@ -170,8 +182,9 @@ main(int argc, char** argv)
       throw UsageError("-max_frames must be >= 0");
 
     const std::string groundtruth_path =
-        args.has("tum_dir") ? (fs::path(args.string("tum_dir")) / "groundtruth.txt").string()
-                            : "";
+        args.has("tum_dir")
+            ? (fs::path(args.string("tum_dir")) / "groundtruth.txt").string()
+            : "";
     dynvo::Trajectory groundtruth;
     if (!groundtruth_path.empty() && fs::exists(groundtruth_path))
       groundtruth = dynvo::readTrajectory(groundtruth_path);
@@ -184,13 +197,15 @@ main(int argc, char** argv)
                                    args.has("init_gt") ? &groundtruth : nullptr);
     dynvo::app::OdometryPipeline pipeline(options);
     RunRenderer renderer(args, options.intrinsics);
-    dynvo::app::RunReport report(max_frames > 0 ? std::min<std::size_t>(max_frames, source->size())
-                                                : source->size());
+    dynvo::app::RunReport report(max_frames > 0
+                                     ? std::min<std::size_t>(max_frames, source->size())
+                                     : source->size());
     dynvo::Frame frame;
     int status = 0;
     try {
-      while ((max_frames == 0 || report.frames() < static_cast<std::size_t>(max_frames)) &&
-             source->next(frame)) {
+      while (
+          (max_frames == 0 || report.frames() < static_cast<std::size_t>(max_frames)) &&
+          source->next(frame)) {
         const auto& result = pipeline.process(frame.cloud, frame.timestamp);
         outputs.add(result);
         renderer.add(frame, result, outputs.trajectory());
@@ -205,9 +220,9 @@ main(int argc, char** argv)
     }
     outputs.finish();
     renderer.finish(outputs.trajectory(), groundtruth);
-    report.printSummary(groundtruth.empty()
-                            ? ""
-                            : dynvo::app::RunReport::accuracy(groundtruth, outputs.trajectory()));
+    report.printSummary(groundtruth.empty() ? ""
+                                            : dynvo::app::RunReport::accuracy(
+                                                  groundtruth, outputs.trajectory()));
     return status;
   });
 }

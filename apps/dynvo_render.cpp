@@ -26,10 +26,11 @@ namespace {
 namespace fs = std::filesystem;
 using dynvo::app::UsageError;
 
-const char* const USAGE =
-    "dynvo_render (-tum_dir DIR | -pcd_dir DIR | -oni FILE) -trajectory FILE -labels_dir DIR "
-    "-out_dir DIR [-groundtruth FILE] [-frames a,b,c | -every N] [-view camera|oblique|top] "
-    "[-plot_plane xz|xy] [-blend B] [camera flags]";
+const char* const USAGE = "dynvo_render (-tum_dir DIR | -pcd_dir DIR | -oni FILE) "
+                          "-trajectory FILE -labels_dir DIR "
+                          "-out_dir DIR [-groundtruth FILE] [-frames a,b,c | -every N] "
+                          "[-view camera|oblique|top] "
+                          "[-plot_plane xz|xy] [-blend B] [camera flags]";
 
 /// A trajectory pose counts as a frame's pose within this many seconds: far above the
 /// 1 us rounding of "%.6f" stamps, far below half a frame period (17 ms at 30 Hz).
@@ -51,7 +52,8 @@ parseFrameList(const std::string& text)
       used = 0;
     }
     if (used == 0 || used != item.size() || index < 0)
-      throw UsageError("-frames takes non-negative frame indices a,b,c; got '" + text + "'");
+      throw UsageError("-frames takes non-negative frame indices a,b,c; got '" + text +
+                       "'");
     frames.insert(index);
   }
   if (frames.empty())
@@ -69,7 +71,8 @@ readLabels(const std::string& path, const pcl::PointCloud<pcl::PointXYZRGB>& clo
   dynvo::LabelImage labels = dynvo::readLabelImage(path);
   if (labels.width != cloud.width || labels.height != cloud.height)
     throw pcl::IOException(path + ": expected a label image of " +
-                           std::to_string(cloud.width) + "x" + std::to_string(cloud.height));
+                           std::to_string(cloud.width) + "x" +
+                           std::to_string(cloud.height));
   return std::move(labels.data);
 }
 
@@ -87,9 +90,11 @@ printSummary(const std::vector<double>& render_ms, const std::string& out_dir)
   if (render_ms.size() > 1) {
     const double later = std::accumulate(render_ms.begin() + 1, render_ms.end(), 0.0);
     pcl::console::print_info(", later mean ");
-    pcl::console::print_value("%.1f ms", later / static_cast<double>(render_ms.size() - 1));
+    pcl::console::print_value("%.1f ms",
+                              later / static_cast<double>(render_ms.size() - 1));
     pcl::console::print_info(", max ");
-    pcl::console::print_value("%.1f ms", *std::max_element(render_ms.begin() + 1, render_ms.end()));
+    pcl::console::print_value(
+        "%.1f ms", *std::max_element(render_ms.begin() + 1, render_ms.end()));
   }
   pcl::console::print_info("\n");
 }
@@ -106,19 +111,24 @@ main(int argc, char** argv)
         options.end(),
         {{"trajectory", "FILE", "estimated TUM trajectory of the run (required)"},
          {"labels_dir", "DIR", "label PNGs <stamp>.png of the run (required)"},
-         {"out_dir", "DIR", "where <stamp>_<view>.png and trajectory.png go (required)"},
-         {"groundtruth", "FILE", "TUM ground truth: adds it and the error curve to the plot"},
+         {"out_dir", "DIR",
+          "where <stamp>_<view>.png and trajectory.png go (required)"},
+         {"groundtruth", "FILE",
+          "TUM ground truth: adds it and the error curve to the plot"},
          {"frames", "a,b,c", "frame indices to render (default: see -every)"},
          {"every", "N", "render every N-th frame (default 1)"},
          {"view", "camera|oblique|top", "viewpoint (default camera)"},
-         {"plot_plane", "xz|xy", "top-down plane of the plot (default xz; xy for z-up ground truth)"},
-         {"blend", "B", "share of the original RGB in each colour (default " +
-                            std::to_string(defaults.rgb_blend) + ")"}});
+         {"plot_plane", "xz|xy",
+          "top-down plane of the plot (default xz; xy for z-up ground truth)"},
+         {"blend", "B",
+          "share of the original RGB in each colour (default " +
+              std::to_string(defaults.rgb_blend) + ")"}});
     const dynvo::app::Arguments args(argc, argv, options, 0);
     if (args.helpRequested()) {
-      std::printf("Usage: %s\n\nRenders the labelled clouds of a finished run off screen "
-                  "(needs an X display: use `xvfb-run -a` on a headless machine).\n\n%s",
-                  USAGE, args.optionsHelp().c_str());
+      std::printf(
+          "Usage: %s\n\nRenders the labelled clouds of a finished run off screen "
+          "(needs an X display: use `xvfb-run -a` on a headless machine).\n\n%s",
+          USAGE, args.optionsHelp().c_str());
       return 0;
     }
     for (const char* required : {"trajectory", "labels_dir", "out_dir"})
@@ -161,9 +171,10 @@ main(int argc, char** argv)
     const auto source = dynvo::app::openFrameSource(args);
     std::string reason;
     if (!dynvo::displayAvailable(&reason)) {
-      pcl::console::print_warn("No display (%s): no images written. Run under `xvfb-run -a` "
-                               "on a headless machine.\n",
-                               reason.c_str());
+      pcl::console::print_warn(
+          "No display (%s): no images written. Run under `xvfb-run -a` "
+          "on a headless machine.\n",
+          reason.c_str());
       return 0;
     }
     const fs::path out_dir = args.string("out_dir");
@@ -179,13 +190,18 @@ main(int argc, char** argv)
     for (long index = 0; source->next(frame); ++index) {
       if (frames.empty() ? index % every != 0 : frames.count(index) == 0)
         continue;
-      const std::string stamp = fs::path(dynvo::labelFileName(frame.timestamp)).stem().string();
-      const std::size_t k = estimate.empty() ? 0 : dynvo::findClosestIndex(stamps, frame.timestamp);
-      const auto labels = readLabels((labels_dir / (stamp + ".png")).string(), *frame.cloud);
-      if (estimate.empty() || std::abs(stamps[k] - frame.timestamp) > POSE_STAMP_TOLERANCE ||
+      const std::string stamp =
+          fs::path(dynvo::labelFileName(frame.timestamp)).stem().string();
+      const std::size_t k =
+          estimate.empty() ? 0 : dynvo::findClosestIndex(stamps, frame.timestamp);
+      const auto labels =
+          readLabels((labels_dir / (stamp + ".png")).string(), *frame.cloud);
+      if (estimate.empty() ||
+          std::abs(stamps[k] - frame.timestamp) > POSE_STAMP_TOLERANCE ||
           labels.empty()) {
-        pcl::console::print_warn("Frame %ld (%s): no %s; skipped.\n", index, stamp.c_str(),
-                                 labels.empty() ? "label PNG" : "pose in the trajectory");
+        pcl::console::print_warn(
+            "Frame %ld (%s): no %s; skipped.\n", index, stamp.c_str(),
+            labels.empty() ? "label PNG" : "pose in the trajectory");
         continue;
       }
       if (frame.cloud->isOrganized()) {
@@ -203,8 +219,9 @@ main(int argc, char** argv)
     }
     if (!groundtruth.empty())
       estimate = dynvo::alignToGroundTruth(groundtruth, estimate);
-    if (!estimate.empty() && !dynvo::writeTrajectoryPlot(estimate, groundtruth,
-                                                         (out_dir / "trajectory.png").string(), plot))
+    if (!estimate.empty() &&
+        !dynvo::writeTrajectoryPlot(estimate, groundtruth,
+                                    (out_dir / "trajectory.png").string(), plot))
       return 1;
 
     printSummary(render_ms, out_dir.string());

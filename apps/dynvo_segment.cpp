@@ -11,7 +11,6 @@
 #include <pcl/exceptions.h>
 #include <pcl/point_types.h>
 
-
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -105,11 +104,11 @@ main(int argc, char** argv)
     for (; (max_frames < 0 || count < max_frames) && source->next(frame); ++count) {
       flow_estimation.shiftCurrentToPrevious();
       flow_estimation.setInputCloud(frame.cloud);
-      const std::string path = (out_dir / dynvo::labelFileName(frame.timestamp)).string();
+      const std::string path =
+          (out_dir / dynvo::labelFileName(frame.timestamp)).string();
       if (count == 0) {
-        dynvo::writeLabelImage(path,
-                               dynvo::paintLabelImage({}, {}, frame.cloud->width,
-                                                      frame.cloud->height));
+        dynvo::writeLabelImage(path, dynvo::paintLabelImage({}, {}, frame.cloud->width,
+                                                            frame.cloud->height));
         continue;
       }
       flow_estimation.compute(*flow);
@@ -118,19 +117,18 @@ main(int argc, char** argv)
       timer.tic();
       segmentation.segment(segments);
       segment_ms += timer.toc();
-      dynvo::writeLabelImage(path,
-                             dynvo::paintLabelImage(segments, segmentation.getSegmentLabels(),
-                                                    frame.cloud->width, frame.cloud->height));
+      dynvo::writeLabelImage(
+          path, dynvo::paintLabelImage(segments, segmentation.getSegmentLabels(),
+                                       frame.cloud->width, frame.cloud->height));
       if (segments.empty())
         continue;
       // Constant-velocity prediction for the next frame (identity until a background exists).
       if (!segments[0].indices.empty())
         segmentation.setPredictedMotion(segmentation.getMotions()[0]);
       for (std::size_t s = 1; s < segments.size() && objects; ++s)
-        objects << dynvo::formatObjectMotionLine(frame.timestamp,
-                                                 segmentation.getSegmentLabels()[s],
-                                                 segments[s].indices.size(),
-                                                 segmentation.getMotions()[s])
+        objects << dynvo::formatObjectMotionLine(
+                       frame.timestamp, segmentation.getSegmentLabels()[s],
+                       segments[s].indices.size(), segmentation.getMotions()[s])
                 << '\n';
     }
     pcl::console::print_highlight("Labelled %ld frames into %s; segmentation ", count,

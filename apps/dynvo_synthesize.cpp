@@ -41,24 +41,30 @@ main(int argc, char** argv)
   return dynvo::app::runApp(USAGE, [&] {
     const dynvo::SynthOptions defaults;
     const long hardware_threads = std::max(1U, std::thread::hardware_concurrency());
-    const auto text = [](auto value) { return std::to_string(value); };
+    const auto text = [](auto value) {
+      return std::to_string(value);
+    };
     const dynvo::app::Arguments args(
         argc, argv,
         {{"scenario", "NAME", "scenario to render (default " + defaults.scenario + ")"},
          {"frames", "N", "number of frames (default " + text(defaults.frames) + ")"},
-         {"seed", "S", "seed of textures and depth noise (default " + text(defaults.seed) + ")"},
+         {"seed", "S",
+          "seed of textures and depth noise (default " + text(defaults.seed) + ")"},
          {"out", "DIR", "output folder; must not exist or be empty (required)"},
-         {"noise", "0|1", "Kinect-like depth model (default " + text(int(defaults.noise)) + ")"},
-         {"threads", "N", "worker threads (default: hardware count, " + text(hardware_threads) + ")"},
+         {"noise", "0|1",
+          "Kinect-like depth model (default " + text(int(defaults.noise)) + ")"},
+         {"threads", "N",
+          "worker threads (default: hardware count, " + text(hardware_threads) + ")"},
          {"width", "W", "image columns in px (default " + text(defaults.width) + ")"},
          {"height", "H", "image rows in px (default " + text(defaults.height) + ")"},
          {"list", "", "print the scenarios and exit"}},
         0);
     if (args.helpRequested()) {
-      std::printf("Usage: %s\n\nRenders textured rooms with rigid moving objects and writes "
-                  "rgb/, depth/, labels/, rgb.txt,\ndepth.txt, groundtruth.txt and "
-                  "objects.txt. The same seed gives the same bytes.\n\n%s",
-                  USAGE, args.optionsHelp().c_str());
+      std::printf(
+          "Usage: %s\n\nRenders textured rooms with rigid moving objects and writes "
+          "rgb/, depth/, labels/, rgb.txt,\ndepth.txt, groundtruth.txt and "
+          "objects.txt. The same seed gives the same bytes.\n\n%s",
+          USAGE, args.optionsHelp().c_str());
       return 0;
     }
     if (args.has("list")) {
@@ -71,13 +77,17 @@ main(int argc, char** argv)
 
     dynvo::SynthOptions options;
     options.scenario = args.string("scenario", defaults.scenario);
-    options.frames = static_cast<int>(boundedInteger(args, "frames", defaults.frames, 1, 1000000));
+    options.frames =
+        static_cast<int>(boundedInteger(args, "frames", defaults.frames, 1, 1000000));
     options.seed = static_cast<std::uint32_t>(
         boundedInteger(args, "seed", defaults.seed, 0, 4294967295L));
     options.noise = boundedInteger(args, "noise", defaults.noise ? 1 : 0, 0, 1) == 1;
-    options.width = static_cast<int>(boundedInteger(args, "width", defaults.width, 8, 8192));
-    options.height = static_cast<int>(boundedInteger(args, "height", defaults.height, 8, 8192));
-    const int threads = static_cast<int>(boundedInteger(args, "threads", hardware_threads, 1, 256));
+    options.width =
+        static_cast<int>(boundedInteger(args, "width", defaults.width, 8, 8192));
+    options.height =
+        static_cast<int>(boundedInteger(args, "height", defaults.height, 8, 8192));
+    const int threads =
+        static_cast<int>(boundedInteger(args, "threads", hardware_threads, 1, 256));
     try {
       options.validate();
     }
@@ -89,10 +99,10 @@ main(int argc, char** argv)
     pcl::console::TicToc timer;
     timer.tic();
     dynvo::SceneSynthesizer(options).writeSequence(out, threads);
-    pcl::console::print_highlight("Wrote %d frames of '%s' (%dx%d, seed %u, noise %s) to %s in ",
-                                  options.frames, options.scenario.c_str(), options.width,
-                                  options.height, options.seed, options.noise ? "on" : "off",
-                                  out.c_str());
+    pcl::console::print_highlight(
+        "Wrote %d frames of '%s' (%dx%d, seed %u, noise %s) to %s in ", options.frames,
+        options.scenario.c_str(), options.width, options.height, options.seed,
+        options.noise ? "on" : "off", out.c_str());
     pcl::console::print_value("%.2f", timer.toc() / 1000.0);
     pcl::console::print_info(" s with %d thread(s)\n", threads);
     return 0;

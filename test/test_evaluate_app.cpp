@@ -16,8 +16,7 @@ using dynvo::test::TempDir;
 
 class EvaluateApp : public ::testing::Test {
 protected:
-  void
-  SetUp() override
+  void SetUp() override
   {
     // 4 s at 30 Hz; the estimate drifts 3 cm/s along x relative to the ground truth.
     dynvo::Trajectory gt, est;
@@ -56,10 +55,12 @@ TEST_F(EvaluateApp, PrintsOneLineWithEveryMetric)
 
 TEST_F(EvaluateApp, JsonAndDeltaOptions)
 {
-  const auto json = runCommand(app_ + " " + gt_ + " " + est_ + " -json -delta 15 -delta_unit f");
+  const auto json =
+      runCommand(app_ + " " + gt_ + " " + est_ + " -json -delta 15 -delta_unit f");
   ASSERT_EQ(json.exit_code, 0) << json.err;
   // Half a second of drift at 3 cm/s.
-  EXPECT_NE(json.out.find("\"rpe_trans_rmse\": 0.015000"), std::string::npos) << json.out;
+  EXPECT_NE(json.out.find("\"rpe_trans_rmse\": 0.015000"), std::string::npos)
+      << json.out;
   EXPECT_NE(json.out.find("\"pairs\": 105"), std::string::npos) << json.out;
 }
 

@@ -22,8 +22,7 @@ using dynvo::test::TempDir;
 
 class OdometryApp : public ::testing::Test {
 protected:
-  static void
-  SetUpTestSuite()
+  static void SetUpTestSuite()
   {
     sequence_ = new TempDir();
     dynvo::SynthOptions options;
@@ -32,14 +31,9 @@ protected:
     dynvo::SceneSynthesizer(options).writeSequence(sequence_->file("seq"), 2);
   }
 
-  static void
-  TearDownTestSuite()
-  {
-    delete sequence_;
-  }
+  static void TearDownTestSuite() { delete sequence_; }
 
-  std::string
-  run(const std::string& flags) const
+  std::string run(const std::string& flags) const
   {
     return app_ + " -tum_dir " + sequence_->file("seq") + " " + flags;
   }
@@ -54,8 +48,9 @@ TempDir* OdometryApp::sequence_ = nullptr;
 
 TEST_F(OdometryApp, WritesTrajectoryLabelsObjectsAndClosingLines)
 {
-  const auto result = runCommand(run("-out " + out_.file("t.txt") + " -labels_dir " +
-                                     out_.file("labels") + " -objects " + out_.file("o.txt")));
+  const auto result =
+      runCommand(run("-out " + out_.file("t.txt") + " -labels_dir " +
+                     out_.file("labels") + " -objects " + out_.file("o.txt")));
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const auto trajectory = dynvo::readTrajectory(out_.file("t.txt"));
   ASSERT_EQ(trajectory.size(), static_cast<std::size_t>(FRAMES));
@@ -69,11 +64,13 @@ TEST_F(OdometryApp, WritesTrajectoryLabelsObjectsAndClosingLines)
     ++images;
   }
   EXPECT_EQ(images, static_cast<std::size_t>(FRAMES));
-  EXPECT_TRUE(fs::exists(out_.file("labels") + "/" + dynvo::labelFileName(trajectory[3].timestamp)));
+  EXPECT_TRUE(fs::exists(out_.file("labels") + "/" +
+                         dynvo::labelFileName(trajectory[3].timestamp)));
   EXPECT_TRUE(fs::exists(out_.file("o.txt")));
   EXPECT_FALSE(fs::exists(out_.file("o.txt.partial")));
   // The folder has a ground truth, so the evaluate line comes before the summary line.
-  EXPECT_TRUE(std::regex_search(result.out, std::regex("rpe_trans_rmse=[0-9.]+ .*pairs=[0-9]+\n")))
+  EXPECT_TRUE(std::regex_search(result.out,
+                                std::regex("rpe_trans_rmse=[0-9.]+ .*pairs=[0-9]+\n")))
       << result.out;
   EXPECT_TRUE(std::regex_search(
       result.out, std::regex("frames=35 lost=[0-9]+ median_ms=[0-9.]+ mean_ms=[0-9.]+ "
@@ -85,20 +82,25 @@ TEST_F(OdometryApp, SameSeedSameBytesWithOneAndTwoThreads)
 {
   ASSERT_EQ(runCommand(run("-threads 1 -out " + out_.file("a.txt"))).exit_code, 0);
   ASSERT_EQ(runCommand(run("-threads 2 -out " + out_.file("b.txt"))).exit_code, 0);
-  EXPECT_EQ(dynvo::test::readText(out_.file("a.txt")), dynvo::test::readText(out_.file("b.txt")));
+  EXPECT_EQ(dynvo::test::readText(out_.file("a.txt")),
+            dynvo::test::readText(out_.file("b.txt")));
 }
 
 TEST_F(OdometryApp, ConfigRoundTripsAndUnknownKeysAreRejected)
 {
-  ASSERT_EQ(runCommand(app_ + " -tum_dir x -write_config " + out_.file("c.yaml")).exit_code, 0);
+  ASSERT_EQ(
+      runCommand(app_ + " -tum_dir x -write_config " + out_.file("c.yaml")).exit_code,
+      0);
   const auto reread = runCommand(run("-max_frames 3 -config " + out_.file("c.yaml")));
   EXPECT_EQ(reread.exit_code, 0) << reread.err;
   EXPECT_NE(reread.out.find("frames=3 "), std::string::npos) << reread.out;
 
-  dynvo::test::writeText(out_.file("bad.yaml"), "%YAML:1.0\nsegmentation:\n  max_hypothesis: 3\n");
+  dynvo::test::writeText(out_.file("bad.yaml"),
+                         "%YAML:1.0\nsegmentation:\n  max_hypothesis: 3\n");
   const auto bad = runCommand(run("-config " + out_.file("bad.yaml")));
   EXPECT_EQ(bad.exit_code, 1);
-  EXPECT_NE(bad.err.find("segmentation.max_hypothesis: unknown key"), std::string::npos) << bad.err;
+  EXPECT_NE(bad.err.find("segmentation.max_hypothesis: unknown key"), std::string::npos)
+      << bad.err;
 }
 
 TEST_F(OdometryApp, CorruptFrameStopsTheRunButKeepsWhatWasComputed)
@@ -110,10 +112,11 @@ TEST_F(OdometryApp, CorruptFrameStopsTheRunButKeepsWhatWasComputed)
     colour.push_back(entry.path());
   std::sort(colour.begin(), colour.end());
   dynvo::test::writeText(colour[6].string(), "not a png");
-  const auto result =
-      runCommand(app_ + " -tum_dir " + out_.file("seq") + " -out " + out_.file("t.txt"));
+  const auto result = runCommand(app_ + " -tum_dir " + out_.file("seq") + " -out " +
+                                 out_.file("t.txt"));
   EXPECT_EQ(result.exit_code, 1);
-  EXPECT_NE(result.err.find(colour[6].filename().string()), std::string::npos) << result.err;
+  EXPECT_NE(result.err.find(colour[6].filename().string()), std::string::npos)
+      << result.err;
   EXPECT_EQ(dynvo::readTrajectory(out_.file("t.txt")).size(), 6u);
 }
 
@@ -125,7 +128,8 @@ TEST_F(OdometryApp, BadFlagsAndMissingInput)
   EXPECT_EQ(runCommand(app_ + " -out x.txt").exit_code, 2); // no source
   const auto missing = runCommand(app_ + " -tum_dir " + out_.file("none"));
   EXPECT_EQ(missing.exit_code, 1);
-  EXPECT_NE(missing.err.find("none: not a directory"), std::string::npos) << missing.err;
+  EXPECT_NE(missing.err.find("none: not a directory"), std::string::npos)
+      << missing.err;
   EXPECT_EQ(runCommand(app_ + " -h").exit_code, 0);
 }
 

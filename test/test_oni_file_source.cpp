@@ -69,8 +69,7 @@ class OniFileSourceTest : public ::testing::Test {
 protected:
   /// Writes a fixture of `frames` frames spaced `period_us` apart into the temp dir
   /// and returns its path.
-  std::string
-  makeFixture(int frames, long period_us = 33333)
+  std::string makeFixture(int frames, long period_us = 33333)
   {
     const std::string file = dir_.file("fixture_" + std::to_string(frames) + "_" +
                                        std::to_string(period_us) + ".oni");
@@ -252,7 +251,9 @@ TEST(OniFileSource, MissingFileThrowsNamingIt)
 {
   dynvo::test::TempDir dir;
   const std::string file = dir.file("does_not_exist.oni");
-  expectIOExceptionNaming(file, [&] { OniFileSource source(file); });
+  expectIOExceptionNaming(file, [&] {
+    OniFileSource source(file);
+  });
 }
 
 TEST(OniFileSource, RandomBytesThrowNamingFile)
@@ -265,7 +266,9 @@ TEST(OniFileSource, RandomBytesThrowNamingFile)
     b = static_cast<char>(random() & 0xff);
   std::ofstream(file, std::ios::binary)
       .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  expectIOExceptionNaming(file, [&] { OniFileSource source(file); });
+  expectIOExceptionNaming(file, [&] {
+    OniFileSource source(file);
+  });
 }
 
 // Passes the header check, so OpenNI2 itself must reject the rest without crashing.
@@ -283,7 +286,9 @@ TEST(OniFileSource, OniMagicFollowedByRandomBytesThrowsNamingFile)
   bytes[3] = '0';
   std::ofstream(file, std::ios::binary)
       .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  expectIOExceptionNaming(file, [&] { OniFileSource source(file); });
+  expectIOExceptionNaming(file, [&] {
+    OniFileSource source(file);
+  });
 }
 
 TEST(OniFileSource, EmptyFileThrowsNamingIt)
@@ -291,14 +296,17 @@ TEST(OniFileSource, EmptyFileThrowsNamingIt)
   dynvo::test::TempDir dir;
   const std::string file = dir.file("empty.oni");
   std::ofstream(file, std::ios::binary).close();
-  expectIOExceptionNaming(file, [&] { OniFileSource source(file); });
+  expectIOExceptionNaming(file, [&] {
+    OniFileSource source(file);
+  });
 }
 
 TEST(OniFileSource, DirectoryThrowsNamingIt)
 {
   dynvo::test::TempDir dir;
-  expectIOExceptionNaming(dir.path().string(),
-                          [&] { OniFileSource source(dir.path().string()); });
+  expectIOExceptionNaming(dir.path().string(), [&] {
+    OniFileSource source(dir.path().string());
+  });
 }
 
 } // namespace

@@ -77,8 +77,9 @@ TEST(PcdSequenceSource, NumericNamesAreTimestamps)
   ASSERT_EQ(pcl::io::savePCDFileBinaryCompressed(dir.file("1305031102.5.pcd"),
                                                  organizedCloud(1.0f)),
             0);
-  ASSERT_EQ(pcl::io::savePCDFileBinary(dir.file("1305031102.25.pcd"), organizedCloud(1.0f)),
-            0);
+  ASSERT_EQ(
+      pcl::io::savePCDFileBinary(dir.file("1305031102.25.pcd"), organizedCloud(1.0f)),
+      0);
   dynvo::PcdSequenceSource source(dir.path().string());
   dynvo::Frame frame;
   ASSERT_TRUE(source.next(frame));
@@ -92,9 +93,11 @@ TEST(PcdSequenceSource, BadInputNamesTheFile)
   EXPECT_THROW(dynvo::PcdSequenceSource("/nonexistent/folder"), pcl::IOException);
   TempDir dir;
   EXPECT_THROW(dynvo::PcdSequenceSource(dir.path().string()), pcl::IOException);
-  EXPECT_THROW(dynvo::PcdSequenceSource(dir.path().string(), 0.0), std::invalid_argument);
+  EXPECT_THROW(dynvo::PcdSequenceSource(dir.path().string(), 0.0),
+               std::invalid_argument);
 
-  const auto expect_next_fails = [&](const std::string& name, const std::string& needle) {
+  const auto expect_next_fails = [&](const std::string& name,
+                                     const std::string& needle) {
     dynvo::PcdSequenceSource source(dir.path().string());
     dynvo::Frame frame;
     try {

@@ -41,11 +41,13 @@ runScenario(const std::string& scenario, int frames, unsigned threads, Edit edit
     if (k == 0)
       T_camera0_world = frame.T_world_camera.inverse();
     edit(k, frame.color, frame.depth);
-    const auto cloud = dynvo::makeOrganizedCloud(frame.color, frame.depth, synth.intrinsics());
+    const auto cloud =
+        dynvo::makeOrganizedCloud(frame.color, frame.depth, synth.intrinsics());
     const auto& result = pipeline.process(cloud, frame.timestamp);
     run.estimate.push_back({frame.timestamp, Eigen::Isometry3d(result.T_world_curr)});
     // The pipeline's world frame is camera 0: express the ground truth there too.
-    run.groundtruth.push_back({frame.timestamp, T_camera0_world * frame.T_world_camera});
+    run.groundtruth.push_back(
+        {frame.timestamp, T_camera0_world * frame.T_world_camera});
     run.lost.push_back(result.lost);
   }
   return run;
@@ -74,13 +76,14 @@ TEST(OdometryPipeline, FollowsAMovingCameraPastAMovingObject)
 TEST(OdometryPipeline, FrameWithoutDepthOrTextureIsLostWithoutDerailing)
 {
   const float nan = std::numeric_limits<float>::quiet_NaN();
-  const SequenceRun run = runScenario("moving_static", 30, 1,
-                              [&](int k, dynvo::ColorImage& color, dynvo::DepthImage& depth) {
-                                if (k == 10)
-                                  std::fill(depth.data.begin(), depth.data.end(), nan);
-                                if (k == 20)
-                                  std::fill(color.data.begin(), color.data.end(), 0);
-                              });
+  const SequenceRun run =
+      runScenario("moving_static", 30, 1,
+                  [&](int k, dynvo::ColorImage& color, dynvo::DepthImage& depth) {
+                    if (k == 10)
+                      std::fill(depth.data.begin(), depth.data.end(), nan);
+                    if (k == 20)
+                      std::fill(color.data.begin(), color.data.end(), 0);
+                  });
   // No valid depth: no 3D flow into frame 10 or out of it. A black image: nothing to track.
   EXPECT_TRUE(run.lost[10]);
   EXPECT_TRUE(run.lost[20]);
@@ -98,7 +101,8 @@ TEST(OdometryPipeline, ThreadCountDoesNotChangeTheResult)
   const SequenceRun one = runScenario("static_two", 12, 1);
   const SequenceRun two = runScenario("static_two", 12, 2);
   for (std::size_t k = 0; k < one.estimate.size(); ++k)
-    EXPECT_EQ(one.estimate[k].T_world_camera.matrix(), two.estimate[k].T_world_camera.matrix())
+    EXPECT_EQ(one.estimate[k].T_world_camera.matrix(),
+              two.estimate[k].T_world_camera.matrix())
         << "frame " << k;
 }
 
@@ -108,7 +112,8 @@ TEST(OdometryPipeline, RejectsFramesThatChangeSizeOrAreNotOrganized)
   dynvo::app::OdometryPipeline pipeline(options);
   auto organized = pcl::make_shared<Cloud>(64, 48, pcl::PointXYZRGB(0.f, 0.f, 1.f));
   EXPECT_NO_THROW(pipeline.process(organized, 0.0));
-  EXPECT_THROW(pipeline.process(pcl::make_shared<Cloud>(32, 48), 0.1), std::invalid_argument);
+  EXPECT_THROW(pipeline.process(pcl::make_shared<Cloud>(32, 48), 0.1),
+               std::invalid_argument);
   auto flat = pcl::make_shared<Cloud>();
   flat->resize(100);
   EXPECT_THROW(pipeline.process(flat, 0.2), std::invalid_argument);

@@ -30,11 +30,11 @@ using Rgb = std::array<std::uint8_t, 3>;
 
 constexpr double PI = 3.14159265358979323846;
 
-#define DYNVO_SKIP_WITHOUT_DISPLAY()                                                      \
-  do {                                                                                    \
-    std::string why;                                                                      \
-    if (!dynvo::displayAvailable(&why))                                                   \
-      GTEST_SKIP() << "no display (" << why << "); run under xvfb-run -a";                \
+#define DYNVO_SKIP_WITHOUT_DISPLAY()                                                   \
+  do {                                                                                 \
+    std::string why;                                                                   \
+    if (!dynvo::displayAvailable(&why))                                                \
+      GTEST_SKIP() << "no display (" << why << "); run under xvfb-run -a";             \
   } while (false)
 
 /// Colour of a PNG pixel (OpenCV reads B, G, R).
@@ -64,8 +64,7 @@ constexpr int COLOUR_ROUNDING = 1;
  * (label 0), a box (label 2) and a disc (label 5) in front. Colours vary smoothly. */
 class LabelledScene : public ::testing::Test {
 protected:
-  void
-  SetUp() override
+  void SetUp() override
   {
     params_.intrinsics.fx = 520.0;
     params_.intrinsics.fy = 535.0;
@@ -100,28 +99,26 @@ protected:
       }
   }
 
-  Rgb
-  expected(std::size_t i) const
+  Rgb expected(std::size_t i) const
   {
     const pcl::PointXYZRGB& p = cloud_[i];
     return LabelRenderer::blendedColor(labels_[i], {p.r, p.g, p.b}, params_.rgb_blend);
   }
 
   /// Renders, times the call and reads the PNG back.
-  cv::Mat
-  renderAndRead(LabelRenderer& renderer,
-                const Eigen::Isometry3d& pose,
-                const dynvo::Trajectory& trajectory,
-                const std::string& name,
-                double* milliseconds = nullptr)
+  cv::Mat renderAndRead(LabelRenderer& renderer,
+                        const Eigen::Isometry3d& pose,
+                        const dynvo::Trajectory& trajectory,
+                        const std::string& name,
+                        double* milliseconds = nullptr)
   {
     const std::string path = dir_.file(name);
     const auto start = std::chrono::steady_clock::now();
     EXPECT_TRUE(renderer.render(cloud_, labels_, pose, trajectory, path));
     if (milliseconds)
-      *milliseconds =
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-              .count();
+      *milliseconds = std::chrono::duration<double, std::milli>(
+                          std::chrono::steady_clock::now() - start)
+                          .count();
     return cv::imread(path, cv::IMREAD_COLOR);
   }
 
@@ -181,7 +178,8 @@ TEST(LabelRendererContract, BadParametersThrow)
   p.frustum_depth = 0.0;
   LabelRenderer renderer;
   EXPECT_THROW(renderer.setParameters(p), std::invalid_argument);
-  EXPECT_EQ(renderer.getParameters().frustum_depth, LabelRenderer::Parameters{}.frustum_depth);
+  EXPECT_EQ(renderer.getParameters().frustum_depth,
+            LabelRenderer::Parameters{}.frustum_depth);
 }
 
 TEST(LabelRendererContract, MismatchedOrEmptyInputWritesNothing)
@@ -228,10 +226,12 @@ TEST(LabelRendererContract, WithoutDisplayRenderAndPlotReturnFalse)
   dynvo::test::TempDir dir;
   pcl::PointCloud<pcl::PointXYZRGB> cloud(4, 3);
   LabelRenderer renderer;
-  for (int attempt = 0; attempt < 2; ++attempt) // the second call must not retry X either
+  for (int attempt = 0; attempt < 2;
+       ++attempt) // the second call must not retry X either
     EXPECT_FALSE(renderer.render(cloud, std::vector<std::uint8_t>(12, 1),
                                  Eigen::Isometry3d::Identity(), {}, dir.file("x.png")));
-  EXPECT_FALSE(dynvo::writeTrajectoryPlot({dynvo::StampedPose{}}, {}, dir.file("t.png")));
+  EXPECT_FALSE(
+      dynvo::writeTrajectoryPlot({dynvo::StampedPose{}}, {}, dir.file("t.png")));
   EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
 }
 
@@ -239,7 +239,8 @@ TEST_F(LabelledScene, CameraViewHasEachLabelColourAtItsProjectedPixel)
 {
   DYNVO_SKIP_WITHOUT_DISPLAY();
   LabelRenderer renderer(params_);
-  const cv::Mat image = renderAndRead(renderer, Eigen::Isometry3d::Identity(), {}, "cam.png");
+  const cv::Mat image =
+      renderAndRead(renderer, Eigen::Isometry3d::Identity(), {}, "cam.png");
   ASSERT_EQ(image.cols, 640);
   ASSERT_EQ(image.rows, 480);
   // Not blank: every pixel holds a valid point, so nothing may stay background black.
@@ -261,8 +262,8 @@ TEST_F(LabelledScene, CameraViewHasEachLabelColourAtItsProjectedPixel)
         best = std::min(best, colourDistance(pixel(image, int(std::lround(uv.x())) + du,
                                                    int(std::lround(uv.y())) + dv),
                                              expected(i)));
-    EXPECT_LE(best, COLOUR_ROUNDING) << "label " << int(labels_[i]) << " at " << s[0] << ","
-                                     << s[1];
+    EXPECT_LE(best, COLOUR_ROUNDING)
+        << "label " << int(labels_[i]) << " at " << s[0] << "," << s[1];
   }
 }
 
@@ -308,7 +309,8 @@ TEST_F(LabelledScene, CameraViewLinesUpWithTheInputFromAnyPose)
       ASSERT_GT(drawn_n, 0.9 * mask_n) << "label " << int(label);
       // A one-pixel shift of the whole object moves the centroid by 1 px; registration
       // errors below that are rounding inside the driver.
-      EXPECT_LT((mask_sum / mask_n - drawn_sum / drawn_n).norm(), 0.5) << "label " << int(label);
+      EXPECT_LT((mask_sum / mask_n - drawn_sum / drawn_n).norm(), 0.5)
+          << "label " << int(label);
     }
   cv::Mat difference;
   cv::absdiff(at_origin, posed, difference);
@@ -321,9 +323,11 @@ TEST_F(LabelledScene, NaNPointsLeaveBackground)
   DYNVO_SKIP_WITHOUT_DISPLAY();
   for (int v = 0; v < 50; ++v)
     for (int u = 0; u < 50; ++u)
-      cloud_[std::size_t(v) * cloud_.width + u].z = std::numeric_limits<float>::quiet_NaN();
+      cloud_[std::size_t(v) * cloud_.width + u].z =
+          std::numeric_limits<float>::quiet_NaN();
   LabelRenderer renderer(params_);
-  const cv::Mat image = renderAndRead(renderer, Eigen::Isometry3d::Identity(), {}, "nan.png");
+  const cv::Mat image =
+      renderAndRead(renderer, Eigen::Isometry3d::Identity(), {}, "nan.png");
   ASSERT_FALSE(image.empty());
   EXPECT_EQ(pixel(image, 25, 25), (Rgb{0, 0, 0}));
   EXPECT_LE(colourDistance(pixel(image, 60, 60), expected(60 * cloud_.width + 60)),
@@ -344,8 +348,8 @@ TEST_F(LabelledScene, SceneViewsShowCloudTrajectoryAndFrustum)
   for (const auto view : {dynvo::RenderView::oblique, dynvo::RenderView::top}) {
     params_.view = view;
     LabelRenderer renderer(params_);
-    const cv::Mat image =
-        renderAndRead(renderer, trajectory.back().T_world_camera, trajectory, "view.png");
+    const cv::Mat image = renderAndRead(renderer, trajectory.back().T_world_camera,
+                                        trajectory, "view.png");
     ASSERT_FALSE(image.empty());
     int white = 0;
     int box = 0;
@@ -371,7 +375,8 @@ TEST_F(LabelledScene, SceneViewsShowCloudTrajectoryAndFrustum)
 
 /// Bounding box of the pixels of one colour inside [x0, x1) x [0, rows).
 cv::Rect
-colourBox(const cv::Mat& image, const Rgb& colour, int x0, int x1, int tolerance, int* count)
+colourBox(
+    const cv::Mat& image, const Rgb& colour, int x0, int x1, int tolerance, int* count)
 {
   int left = x1, right = -1, top = image.rows, bottom = -1;
   *count = 0;
@@ -405,7 +410,8 @@ TEST(TrajectoryPlot, CurvesAreInsideTheirPlotAreas)
   }
   dynvo::test::TempDir dir;
   const dynvo::TrajectoryPlotOptions options;
-  ASSERT_TRUE(dynvo::writeTrajectoryPlot(estimate, groundtruth, dir.file("plot.png"), options));
+  ASSERT_TRUE(
+      dynvo::writeTrajectoryPlot(estimate, groundtruth, dir.file("plot.png"), options));
   const cv::Mat image = cv::imread(dir.file("plot.png"), cv::IMREAD_COLOR);
   ASSERT_EQ(image.cols, int(options.width));
   ASSERT_EQ(image.rows, int(options.height));
@@ -420,11 +426,13 @@ TEST(TrajectoryPlot, CurvesAreInsideTheirPlotAreas)
     Rgb colour;
     int x0, x1;
   };
-  for (const Curve& curve : {Curve{"estimate path", options.estimate_color, 0, half},
-                             Curve{"ground-truth path", options.groundtruth_color, 0, half},
-                             Curve{"error curve", options.estimate_color, half, image.cols}}) {
+  for (const Curve& curve :
+       {Curve{"estimate path", options.estimate_color, 0, half},
+        Curve{"ground-truth path", options.groundtruth_color, 0, half},
+        Curve{"error curve", options.estimate_color, half, image.cols}}) {
     int count = 0;
-    const cv::Rect box = colourBox(image, curve.colour, curve.x0, curve.x1, tolerance, &count);
+    const cv::Rect box =
+        colourBox(image, curve.colour, curve.x0, curve.x1, tolerance, &count);
     // A 2-px circle of at least 40% of a 640x480 chart is several hundred pixels long.
     EXPECT_GT(count, 200) << curve.name;
     EXPECT_GE(box.x, curve.x0 + margin) << curve.name;

@@ -14,10 +14,13 @@
 namespace {
 
 Eigen::Matrix4d
-makeTransform(const Eigen::Vector3d& axis, double angle, const Eigen::Vector3d& translation)
+makeTransform(const Eigen::Vector3d& axis,
+              double angle,
+              const Eigen::Vector3d& translation)
 {
   Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
-  T.topLeftCorner<3, 3>() = Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
+  T.topLeftCorner<3, 3>() =
+      Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
   T.topRightCorner<3, 1>() = translation;
   return T;
 }
@@ -30,12 +33,17 @@ apply(const Eigen::Matrix4d& T, const Eigen::Vector3d& p)
 
 /// Rotation angle (rad) and translation distance (m) between two rigid transformations.
 void
-poseDifference(const Eigen::Matrix4d& A, const Eigen::Matrix4d& B, double& angle, double& dist)
+poseDifference(const Eigen::Matrix4d& A,
+               const Eigen::Matrix4d& B,
+               double& angle,
+               double& dist)
 {
-  const Eigen::Matrix3d dR = A.topLeftCorner<3, 3>().transpose() * B.topLeftCorner<3, 3>();
+  const Eigen::Matrix3d dR =
+      A.topLeftCorner<3, 3>().transpose() * B.topLeftCorner<3, 3>();
   // atan2 of the skew and symmetric parts: acos((trace - 1) / 2) cannot resolve angles below
   // sqrt(2 * 1e-16) = 1.5e-8 rad in double precision.
-  const Eigen::Vector3d skew(dR(2, 1) - dR(1, 2), dR(0, 2) - dR(2, 0), dR(1, 0) - dR(0, 1));
+  const Eigen::Vector3d skew(dR(2, 1) - dR(1, 2), dR(0, 2) - dR(2, 0),
+                             dR(1, 0) - dR(0, 1));
   angle = std::atan2(skew.norm() / 2.0, (dR.trace() - 1.0) / 2.0);
   dist = (A.topRightCorner<3, 1>() - B.topRightCorner<3, 1>()).norm();
 }
@@ -47,11 +55,12 @@ constexpr double EXACT = 1e-9;
 TEST(RigidFitAccumulator, RecoversRandomMotionsFromExactPairs)
 {
   std::mt19937 rng(7);
-  std::uniform_real_distribution<double> coord(-2.0, 2.0), weight(0.1, 1.0), angle(-1.5, 1.5);
+  std::uniform_real_distribution<double> coord(-2.0, 2.0), weight(0.1, 1.0),
+      angle(-1.5, 1.5);
   for (int trial = 0; trial < 20; ++trial) {
-    const Eigen::Matrix4d T = makeTransform(Eigen::Vector3d(coord(rng), coord(rng), coord(rng)),
-                                            angle(rng),
-                                            Eigen::Vector3d(coord(rng), coord(rng), coord(rng)));
+    const Eigen::Matrix4d T =
+        makeTransform(Eigen::Vector3d(coord(rng), coord(rng), coord(rng)), angle(rng),
+                      Eigen::Vector3d(coord(rng), coord(rng), coord(rng)));
     dynvo::RigidFitAccumulator fit;
     for (int i = 0; i < 30; ++i) {
       const Eigen::Vector3d s(coord(rng), coord(rng), coord(rng) + 3.0);
@@ -71,8 +80,10 @@ TEST(RigidFitAccumulator, WeightsDecideBetweenTwoMotions)
 {
   // Two interleaved rigid motions: the fit follows the heavily weighted one, and pairs of
   // weight 0 are ignored exactly.
-  const Eigen::Matrix4d A = makeTransform(Eigen::Vector3d::UnitY(), 0.1, {0.05, 0.0, 0.0});
-  const Eigen::Matrix4d B = makeTransform(Eigen::Vector3d::UnitX(), -0.3, {0.0, 0.2, 0.1});
+  const Eigen::Matrix4d A =
+      makeTransform(Eigen::Vector3d::UnitY(), 0.1, {0.05, 0.0, 0.0});
+  const Eigen::Matrix4d B =
+      makeTransform(Eigen::Vector3d::UnitX(), -0.3, {0.0, 0.2, 0.1});
   dynvo::RigidFitAccumulator fit;
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> coord(-1.0, 1.0);
@@ -94,7 +105,8 @@ TEST(RigidFitAccumulator, PlanarPointsGiveAProperRotation)
 {
   // A plane (z = 2) rotated by 180 degrees about its normal: without the reflection guard the
   // SVD of a rank-2 cross-covariance can return a mirror (det = -1).
-  const Eigen::Matrix4d T = makeTransform(Eigen::Vector3d::UnitZ(), 3.0, {0.1, -0.2, 0.3});
+  const Eigen::Matrix4d T =
+      makeTransform(Eigen::Vector3d::UnitZ(), 3.0, {0.1, -0.2, 0.3});
   dynvo::RigidFitAccumulator fit;
   for (int i = 0; i < 5; ++i)
     for (int j = 0; j < 5; ++j) {
@@ -117,12 +129,14 @@ TEST(RigidFitAccumulator, PointsFarFromTheOriginKeepTheirPrecision)
   // (1e4^2 * 1e-16 = 1e-8 m^2 of round-off against 1e-6 m^2 of spread); the first-pair
   // origin keeps the error at round-off of the offsets (~1e-12 m), so 1e-7 rad / 1e-9 m hold.
   const Eigen::Vector3d far(1e4, -1e4, 1e4);
-  const Eigen::Matrix4d T = makeTransform(Eigen::Vector3d(1, 2, 3), 0.2, {0.001, 0.002, 0.0});
+  const Eigen::Matrix4d T =
+      makeTransform(Eigen::Vector3d(1, 2, 3), 0.2, {0.001, 0.002, 0.0});
   const Eigen::Matrix4d T_centred =
       makeTransform(Eigen::Vector3d(1, 2, 3), 0.2, Eigen::Vector3d::Zero());
   dynvo::RigidFitAccumulator fit;
   const double mm = 1e-3;
-  const Eigen::Vector3d offsets[] = {{0, 0, 0}, {mm, 0, 0}, {0, mm, 0}, {0, 0, mm}, {mm, mm, mm}};
+  const Eigen::Vector3d offsets[] = {
+      {0, 0, 0}, {mm, 0, 0}, {0, mm, 0}, {0, 0, mm}, {mm, mm, mm}};
   for (const auto& o : offsets)
     fit.add(far + o, far + apply(T_centred, o) + T.topRightCorner<3, 1>());
   Eigen::Matrix4d estimate;
@@ -132,7 +146,8 @@ TEST(RigidFitAccumulator, PointsFarFromTheOriginKeepTheirPrecision)
   EXPECT_LT(dangle, 1e-7);
   for (const auto& o : offsets)
     EXPECT_LT(dynvo::squaredTransferError(estimate, far + o,
-                                          far + apply(T_centred, o) + T.topRightCorner<3, 1>()),
+                                          far + apply(T_centred, o) +
+                                              T.topRightCorner<3, 1>()),
               1e-18);
 }
 
@@ -177,7 +192,8 @@ TEST(RigidFitAccumulator, RejectsNonFiniteInputAndNegativeWeights)
 
 TEST(RigidFitAccumulator, SquaredTransferErrorIsTheResidualOfEquationOne)
 {
-  const Eigen::Matrix4d T = makeTransform(Eigen::Vector3d::UnitZ(), M_PI / 2, {1.0, 0.0, 0.0});
+  const Eigen::Matrix4d T =
+      makeTransform(Eigen::Vector3d::UnitZ(), M_PI / 2, {1.0, 0.0, 0.0});
   // R (1,0,0) + t = (0,1,0) + (1,0,0) = (1,1,0); the target is 3 cm away along z.
   EXPECT_NEAR(dynvo::squaredTransferError(T, {1, 0, 0}, {1, 1, 0.03}), 9e-4, 1e-15);
 }

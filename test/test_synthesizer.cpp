@@ -69,7 +69,10 @@ distanceToBoxSurface(const dynvo::ObjectState& object, const Eigen::Vector3d& p_
 }
 
 Eigen::Vector3d
-worldPoint(const dynvo::SynthFrame& frame, const dynvo::CameraIntrinsics& K, int u, int v)
+worldPoint(const dynvo::SynthFrame& frame,
+           const dynvo::CameraIntrinsics& K,
+           int u,
+           int v)
 {
   const float z = frame.depth.data[static_cast<std::size_t>(v) * frame.depth.width + u];
   return frame.T_world_camera * K.backproject(u, v, z).cast<double>();
@@ -134,18 +137,21 @@ TEST(SceneSynthesizer, StaticPixelsAgreeAcrossFramesWithGroundTruth)
   const dynvo::SynthFrame f0 = synth.render(20), f1 = synth.render(21);
   const Eigen::Isometry3d T_1_0 = f1.T_world_camera.inverse() * f0.T_world_camera;
   const int w = options.width, h = options.height;
-  const auto at = [w](const std::vector<float>& d, int u, int v) { return d[v * w + u]; };
+  const auto at = [w](const std::vector<float>& d, int u, int v) {
+    return d[v * w + u];
+  };
   int checked = 0, depth_ok = 0;
   double colour_error = 0.0;
   for (int v = 0; v < h; v += 2) {
     for (int u = 0; u < w; u += 2) {
       if (f0.labels[v * w + u] != 0)
         continue;
-      const Eigen::Vector3f p1 = (T_1_0 * K.backproject(u, v, at(f0.depth.data, u, v))
-                                               .cast<double>())
-                                     .cast<float>();
+      const Eigen::Vector3f p1 =
+          (T_1_0 * K.backproject(u, v, at(f0.depth.data, u, v)).cast<double>())
+              .cast<float>();
       const Eigen::Vector2f uv = K.project(p1);
-      const int u0 = static_cast<int>(std::floor(uv.x())), v0 = static_cast<int>(std::floor(uv.y()));
+      const int u0 = static_cast<int>(std::floor(uv.x())),
+                v0 = static_cast<int>(std::floor(uv.y()));
       if (u0 < 0 || v0 < 0 || u0 + 1 >= w || v0 + 1 >= h)
         continue;
       const float a = uv.x() - u0, b = uv.y() - v0;
@@ -168,7 +174,8 @@ TEST(SceneSynthesizer, StaticPixelsAgreeAcrossFramesWithGroundTruth)
       depth_ok += std::abs(1.0f / interpolated - p1.z()) < 1e-3f;
       for (int channel = 0; channel < 3; ++channel) {
         const auto c = [&](int du, int dv) {
-          return static_cast<float>(f1.color.data[3 * ((v0 + dv) * w + u0 + du) + channel]);
+          return static_cast<float>(
+              f1.color.data[3 * ((v0 + dv) * w + u0 + du) + channel]);
         };
         const float expected = (1 - b) * ((1 - a) * c(0, 0) + a * c(1, 0)) +
                                b * ((1 - a) * c(0, 1) + a * c(1, 1));
@@ -303,12 +310,15 @@ TEST(SceneSynthesizer, ScenariosHaveTheirDefiningProperties)
     for (int k = 1; k < 300; ++k) {
       const dynvo::SynthFrame frame = synth.render(k);
       const double camera_step =
-          (frame.T_world_camera.translation() - previous.T_world_camera.translation()).norm();
+          (frame.T_world_camera.translation() - previous.T_world_camera.translation())
+              .norm();
       max_camera_speed = std::max(max_camera_speed, camera_step * 30.0);
-      max_camera_rate = std::max(
-          max_camera_rate, rotationDeg(frame.T_world_camera, previous.T_world_camera) * 30.0);
+      max_camera_rate =
+          std::max(max_camera_rate,
+                   rotationDeg(frame.T_world_camera, previous.T_world_camera) * 30.0);
       if (static_camera) {
-        EXPECT_TRUE(frame.T_world_camera.isApprox(previous.T_world_camera, 0.0)) << info.name;
+        EXPECT_TRUE(frame.T_world_camera.isApprox(previous.T_world_camera, 0.0))
+            << info.name;
       }
       for (std::size_t j = 0; j < frame.objects.size(); ++j) {
         const dynvo::ObjectState& now = frame.objects[j];
@@ -321,11 +331,14 @@ TEST(SceneSynthesizer, ScenariosHaveTheirDefiningProperties)
         }
         else {
           ++still_frames[now.id];
-          EXPECT_TRUE(now.T_world_object.isApprox(previous.objects[j].T_world_object, 0.0));
+          EXPECT_TRUE(
+              now.T_world_object.isApprox(previous.objects[j].T_world_object, 0.0));
         }
       }
       const double labelled =
-          std::count_if(frame.labels.begin(), frame.labels.end(), [](auto l) { return l != 0; });
+          std::count_if(frame.labels.begin(), frame.labels.end(), [](auto l) {
+            return l != 0;
+          });
       max_coverage = std::max(max_coverage, labelled / frame.labels.size());
       previous = frame;
     }
@@ -365,13 +378,27 @@ TEST(SceneSynthesizer, RejectsBadOptions)
     EXPECT_THROW(options.validate(), std::invalid_argument);
     EXPECT_THROW(dynvo::SceneSynthesizer{options}, std::invalid_argument);
   };
-  rejects([](dynvo::SynthOptions& o) { o.scenario = "moving"; });
-  rejects([](dynvo::SynthOptions& o) { o.frames = 0; });
-  rejects([](dynvo::SynthOptions& o) { o.width = 4; });
-  rejects([](dynvo::SynthOptions& o) { o.height = 100000; });
-  rejects([](dynvo::SynthOptions& o) { o.fps = 0.0; });
-  rejects([](dynvo::SynthOptions& o) { o.fps = std::nan(""); });
-  rejects([](dynvo::SynthOptions& o) { o.intrinsics.fx = -1.0; });
+  rejects([](dynvo::SynthOptions& o) {
+    o.scenario = "moving";
+  });
+  rejects([](dynvo::SynthOptions& o) {
+    o.frames = 0;
+  });
+  rejects([](dynvo::SynthOptions& o) {
+    o.width = 4;
+  });
+  rejects([](dynvo::SynthOptions& o) {
+    o.height = 100000;
+  });
+  rejects([](dynvo::SynthOptions& o) {
+    o.fps = 0.0;
+  });
+  rejects([](dynvo::SynthOptions& o) {
+    o.fps = std::nan("");
+  });
+  rejects([](dynvo::SynthOptions& o) {
+    o.intrinsics.fx = -1.0;
+  });
   EXPECT_NO_THROW(dynvo::SynthOptions().validate());
 
   dynvo::SynthOptions options = smallOptions("static_one");
@@ -414,7 +441,8 @@ TEST(SceneSynthesizer, WrittenSequenceReadsBackAsTum)
   read_options.intrinsics = synth.intrinsics();
   const dynvo::TumFolderSource source(dir.file("seq"), read_options);
   ASSERT_EQ(source.size(), 3U);
-  const dynvo::Trajectory groundtruth = dynvo::readTrajectory(dir.file("seq/groundtruth.txt"));
+  const dynvo::Trajectory groundtruth =
+      dynvo::readTrajectory(dir.file("seq/groundtruth.txt"));
   ASSERT_EQ(groundtruth.size(), 3U);
   std::ifstream objects(dir.file("seq/objects.txt"));
   std::string line;
@@ -444,16 +472,20 @@ TEST(SceneSynthesizer, WrittenSequenceReadsBackAsTum)
       std::istringstream fields(object_lines[2 * k + j]);
       double stamp, t[3], q[4];
       int id, moving;
-      fields >> stamp >> id >> t[0] >> t[1] >> t[2] >> q[0] >> q[1] >> q[2] >> q[3] >> moving;
+      fields >> stamp >> id >> t[0] >> t[1] >> t[2] >> q[0] >> q[1] >> q[2] >> q[3] >>
+          moving;
       ASSERT_TRUE(fields) << object_lines[2 * k + j];
       const dynvo::ObjectState& object = rendered.objects[j];
       EXPECT_EQ(id, object.id);
       EXPECT_EQ(moving == 1, object.moving);
-      EXPECT_NEAR((Eigen::Vector3d(t[0], t[1], t[2]) - object.T_world_object.translation()).norm(),
-                  0.0, 1e-7);
-      EXPECT_NEAR(std::abs(Eigen::Quaterniond(q[3], q[0], q[1], q[2])
-                               .dot(Eigen::Quaterniond(object.T_world_object.linear()))),
-                  1.0, 1e-7);
+      EXPECT_NEAR(
+          (Eigen::Vector3d(t[0], t[1], t[2]) - object.T_world_object.translation())
+              .norm(),
+          0.0, 1e-7);
+      EXPECT_NEAR(
+          std::abs(Eigen::Quaterniond(q[3], q[0], q[1], q[2])
+                       .dot(Eigen::Quaterniond(object.T_world_object.linear()))),
+          1.0, 1e-7);
     }
   }
 }

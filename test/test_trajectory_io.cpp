@@ -57,7 +57,8 @@ TEST(TrajectoryIo, WriteThenReadRoundTrips)
 TEST(TrajectoryIo, CommentsBlankLinesAndCommasAreAccepted)
 {
   TempDir dir;
-  writeText(dir.file("t.txt"), "# header\n\n1.0 0 0 0 0 0 0 1\n  \n2.0,1,2,3,0,0,0,1\n");
+  writeText(dir.file("t.txt"),
+            "# header\n\n1.0 0 0 0 0 0 0 1\n  \n2.0,1,2,3,0,0,0,1\n");
   const auto loaded = dynvo::readTrajectory(dir.file("t.txt"));
   ASSERT_EQ(loaded.size(), 2u);
   EXPECT_DOUBLE_EQ(loaded[1].T_world_camera.translation().z(), 3.0);
@@ -69,7 +70,8 @@ TEST(TrajectoryIo, QuaternionIsNormalisedWithinTolerance)
   // Norm 1.0005 is within the 1e-3 tolerance (rounding in files written with few digits).
   writeText(dir.file("t.txt"), "1.0 0 0 0 0 0 0 1.0005\n");
   const auto loaded = dynvo::readTrajectory(dir.file("t.txt"));
-  EXPECT_TRUE(loaded[0].T_world_camera.linear().isApprox(Eigen::Matrix3d::Identity(), 1e-12));
+  EXPECT_TRUE(
+      loaded[0].T_world_camera.linear().isApprox(Eigen::Matrix3d::Identity(), 1e-12));
 }
 
 TEST(TrajectoryIo, EveryViolationNamesFileAndLine)
@@ -94,7 +96,8 @@ TEST(TrajectoryIo, FormatKeepsQwNonNegative)
   pose.timestamp = 3.5;
   // A rotation of 350 degrees: Eigen may produce qw < 0; the file must show qw >= 0.
   pose.T_world_camera.linear() =
-      Eigen::AngleAxisd(350.0 * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+      Eigen::AngleAxisd(350.0 * M_PI / 180.0, Eigen::Vector3d::UnitZ())
+          .toRotationMatrix();
   const std::string line = dynvo::formatTumLine(pose);
   double t, x, y, z, qx, qy, qz, qw;
   ASSERT_EQ(std::sscanf(line.c_str(), "%lf %lf %lf %lf %lf %lf %lf %lf", &t, &x, &y, &z,

@@ -25,7 +25,8 @@ Eigen::Isometry3d
 wobble(double t)
 {
   return Eigen::Translation3d(0.3 * std::sin(t), 0.1 * t, 1.0 + 0.2 * std::cos(2 * t)) *
-         Eigen::AngleAxisd(0.4 * std::sin(0.7 * t), Eigen::Vector3d(0.2, 1, 0.3).normalized());
+         Eigen::AngleAxisd(0.4 * std::sin(0.7 * t),
+                           Eigen::Vector3d(0.2, 1, 0.3).normalized());
 }
 
 TEST(TrajectoryMetrics, IdenticalTrajectoriesScoreZero)
@@ -46,9 +47,12 @@ TEST(TrajectoryMetrics, ConstantRigidOffsetGivesZeroAteAndRpe)
   // The same motion expressed in another world frame: relative poses are unchanged and
   // rigid alignment removes the offset entirely.
   const Eigen::Isometry3d T_other_world =
-      Eigen::Translation3d(2.0, -1.0, 0.5) * Eigen::AngleAxisd(1.2, Eigen::Vector3d::UnitZ());
+      Eigen::Translation3d(2.0, -1.0, 0.5) *
+      Eigen::AngleAxisd(1.2, Eigen::Vector3d::UnitZ());
   const auto gt = sample(5.0, wobble);
-  const auto est = sample(5.0, [&](double t) { return T_other_world * wobble(t); });
+  const auto est = sample(5.0, [&](double t) {
+    return T_other_world * wobble(t);
+  });
   EXPECT_NEAR(dynvo::computeAte(gt, est).rmse, 0.0, 1e-9);
   EXPECT_NEAR(dynvo::computeRpe(gt, est).trans_rmse, 0.0, 1e-9);
   EXPECT_TRUE(dynvo::computeAte(gt, est).T_groundtruth_estimate.isApprox(
@@ -59,10 +63,13 @@ TEST(TrajectoryMetrics, KnownDriftPerSecondGivesKnownRpe)
 {
   // Static camera in the ground truth; the estimate drifts 1 cm/s along x and turns
   // 2 deg/s about z. Over the 1 s delta the error is exactly 0.01 m and 2 degrees.
-  const auto gt = sample(5.0, [](double) { return Eigen::Isometry3d::Identity(); });
+  const auto gt = sample(5.0, [](double) {
+    return Eigen::Isometry3d::Identity();
+  });
   const auto est = sample(5.0, [](double t) {
-    return Eigen::Isometry3d(Eigen::Translation3d(0.01 * t, 0.0, 0.0) *
-                             Eigen::AngleAxisd(2.0 * M_PI / 180.0 * t, Eigen::Vector3d::UnitZ()));
+    return Eigen::Isometry3d(
+        Eigen::Translation3d(0.01 * t, 0.0, 0.0) *
+        Eigen::AngleAxisd(2.0 * M_PI / 180.0 * t, Eigen::Vector3d::UnitZ()));
   });
   const auto rpe = dynvo::computeRpe(gt, est);
   EXPECT_NEAR(rpe.trans_rmse, 0.01, 1e-9);
@@ -83,7 +90,9 @@ TEST(TrajectoryMetrics, KnownDriftPerSecondGivesKnownRpe)
 TEST(TrajectoryMetrics, PairsWithoutGroundTruthAreSkipped)
 {
   // A static camera, so that substituting a nearby gt pose changes nothing.
-  const auto line = [](double) { return Eigen::Isometry3d::Identity(); };
+  const auto line = [](double) {
+    return Eigen::Isometry3d::Identity();
+  };
   auto gt = sample(5.0, line);
   // Remove ground truth between 1 s and 2 s: estimate stamps more than twice the median
   // gt period (2/30 s) from any remaining gt stamp lose their pairs.
@@ -118,8 +127,8 @@ TEST(TrajectoryMetrics, DegenerateInputsThrow)
 
 TEST(TrajectoryMetricsRealData, Fr1GroundTruthAgainstDriftingCopy)
 {
-  const auto path =
-      std::filesystem::path(DYNVO_SHARED_DATA_DIR) / "tum_fr1_xyz_200" / "groundtruth.txt";
+  const auto path = std::filesystem::path(DYNVO_SHARED_DATA_DIR) / "tum_fr1_xyz_200" /
+                    "groundtruth.txt";
   if (!std::filesystem::exists(path))
     GTEST_SKIP() << "shared data not found at " << path;
   const auto gt = dynvo::readTrajectory(path.string());
@@ -130,7 +139,8 @@ TEST(TrajectoryMetricsRealData, Fr1GroundTruthAgainstDriftingCopy)
   const double v = 0.02;
   for (std::size_t i = 0; i < gt.size(); i += 3) {
     auto pose = gt[i];
-    pose.T_world_camera.pretranslate(Eigen::Vector3d(v * (pose.timestamp - gt[0].timestamp), 0, 0));
+    pose.T_world_camera.pretranslate(
+        Eigen::Vector3d(v * (pose.timestamp - gt[0].timestamp), 0, 0));
     est.push_back(pose);
   }
   const auto rpe = dynvo::computeRpe(gt, est);

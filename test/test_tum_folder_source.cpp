@@ -23,15 +23,13 @@ using dynvo::test::writeText;
 /// except pixel (0, 0), which is 0 (missing).
 class TumFolderTest : public ::testing::Test {
 protected:
-  void
-  SetUp() override
+  void SetUp() override
   {
     fs::create_directories(dir_.path() / "rgb");
     fs::create_directories(dir_.path() / "depth");
   }
 
-  void
-  writeImages(const std::string& stamp)
+  void writeImages(const std::string& stamp)
   {
     cv::Mat bgr(3, 4, CV_8UC3), depth(3, 4, CV_16UC1);
     for (int v = 0; v < 3; ++v)
@@ -44,8 +42,7 @@ protected:
     ASSERT_TRUE(cv::imwrite(dir_.file("depth/" + stamp + ".png"), depth));
   }
 
-  dynvo::TumFolderSource::Options
-  options() const
+  dynvo::TumFolderSource::Options options() const
   {
     dynvo::TumFolderSource::Options o;
     o.intrinsics = dynvo::CameraIntrinsics::fromPreset("fr1");
@@ -150,12 +147,16 @@ TEST_F(TumFolderTest, BadInputNamesTheFileAndProblem)
   expectFailure(dir_.path().string(), options(), "rgb/a.png: cannot read colour image");
 
   // An 8-bit depth image is the wrong type.
-  ASSERT_TRUE(cv::imwrite(dir_.file("rgb/a.png"), cv::Mat(3, 4, CV_8UC3, cv::Scalar(1, 2, 3))));
-  ASSERT_TRUE(cv::imwrite(dir_.file("depth/a.png"), cv::Mat(3, 4, CV_8UC1, cv::Scalar(9))));
-  expectFailure(dir_.path().string(), options(), "depth/a.png: depth image must be 16-bit");
+  ASSERT_TRUE(
+      cv::imwrite(dir_.file("rgb/a.png"), cv::Mat(3, 4, CV_8UC3, cv::Scalar(1, 2, 3))));
+  ASSERT_TRUE(
+      cv::imwrite(dir_.file("depth/a.png"), cv::Mat(3, 4, CV_8UC1, cv::Scalar(9))));
+  expectFailure(dir_.path().string(), options(),
+                "depth/a.png: depth image must be 16-bit");
 
   // Colour and depth of different sizes.
-  ASSERT_TRUE(cv::imwrite(dir_.file("depth/a.png"), cv::Mat(2, 4, CV_16UC1, cv::Scalar(9))));
+  ASSERT_TRUE(
+      cv::imwrite(dir_.file("depth/a.png"), cv::Mat(2, 4, CV_16UC1, cv::Scalar(9))));
   expectFailure(dir_.path().string(), options(), "depth image size differs");
 
   writeText(dir_.file("depth.txt"), "3.0 depth/a.png\n");

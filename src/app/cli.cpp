@@ -15,7 +15,7 @@ Arguments::Arguments(int argc,
                      const char* const* argv,
                      std::vector<Option> options,
                      std::size_t positional)
-: options_(std::move(options))
+    : options_(std::move(options))
 {
   for (int k = 1; k < argc; ++k) {
     const std::string token = argv[k];
@@ -23,16 +23,18 @@ Arguments::Arguments(int argc,
       help_ = true;
       continue;
     }
-    const bool is_flag = token.size() > 1 && token[0] == '-' &&
-                         !(std::isdigit(static_cast<unsigned char>(token[1])) ||
-                           token[1] == '.');
+    const bool is_flag =
+        token.size() > 1 && token[0] == '-' &&
+        !(std::isdigit(static_cast<unsigned char>(token[1])) || token[1] == '.');
     if (!is_flag) {
       positional_.push_back(token);
       continue;
     }
     const std::string name = token.substr(1);
-    const auto option = std::find_if(options_.begin(), options_.end(),
-                                     [&](const Option& o) { return o.name == name; });
+    const auto option =
+        std::find_if(options_.begin(), options_.end(), [&](const Option& o) {
+          return o.name == name;
+        });
     if (option == options_.end())
       throw UsageError("unknown option '" + token + "'");
     if (has(name))
@@ -55,8 +57,9 @@ Arguments::Arguments(int argc,
 bool
 Arguments::has(const std::string& name) const
 {
-  return std::any_of(given_.begin(), given_.end(),
-                     [&](const auto& g) { return g.first == name; });
+  return std::any_of(given_.begin(), given_.end(), [&](const auto& g) {
+    return g.first == name;
+  });
 }
 
 std::string

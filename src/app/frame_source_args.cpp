@@ -21,8 +21,10 @@ frameSourceOptions()
       {"fy", "PX", "focal length y, overrides the preset"},
       {"cx", "PX", "principal point x, overrides the preset"},
       {"cy", "PX", "principal point y, overrides the preset"},
-      {"depth_scale", "S", "raw depth units per metre (default: 5000 TUM, 1000 associations.txt)"},
-      {"fps", "HZ", "frame rate for PCD files whose names are not timestamps (default 30)"},
+      {"depth_scale", "S",
+       "raw depth units per metre (default: 5000 TUM, 1000 associations.txt)"},
+      {"fps", "HZ",
+       "frame rate for PCD files whose names are not timestamps (default 30)"},
   };
 }
 

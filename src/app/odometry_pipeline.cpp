@@ -57,7 +57,10 @@ allValidCells(const pcl::PointCloud<PointFlow>& flow, std::uint32_t image_width)
 
 } // namespace
 
-PipelineOptions::PipelineOptions() { segmentation.inlier_threshold = 6e-5f; }
+PipelineOptions::PipelineOptions()
+{
+  segmentation.inlier_threshold = 6e-5f;
+}
 
 void
 PipelineOptions::validate() const
@@ -67,7 +70,8 @@ PipelineOptions::validate() const
   segmentation.validate();
   registration.validate();
   if (threads == 0)
-    throw std::invalid_argument("[dynvo::app::PipelineOptions] threads must be at least 1");
+    throw std::invalid_argument(
+        "[dynvo::app::PipelineOptions] threads must be at least 1");
   if (!(static_consensus >= 0.0f))
     throw std::invalid_argument(
         "[dynvo::app::PipelineOptions] static_consensus must be >= 0");
@@ -79,7 +83,8 @@ PipelineOptions::validate() const
 }
 
 struct OdometryPipeline::Impl {
-  explicit Impl(const PipelineOptions& o) : options(o)
+  explicit Impl(const PipelineOptions& o)
+      : options(o)
   {
     options.validate();
     flow_estimation.setCameraIntrinsics(options.intrinsics);
@@ -91,8 +96,7 @@ struct OdometryPipeline::Impl {
     registration.setParameters(options.registration);
   }
 
-  void
-  track(const Cloud::ConstPtr& cloud)
+  void track(const Cloud::ConstPtr& cloud)
   {
     const auto flow_start = Clock::now();
     flow_estimation.shiftCurrentToPrevious();
@@ -133,15 +137,15 @@ struct OdometryPipeline::Impl {
     if (options.use_segmentation && options.static_consensus > 0.0f)
       align(consensusCells(*flow, cloud->width, T_prev_curr), T_prev_curr);
     result.lost = !registration.hasConverged();
-    result.T_curr_prev = result.lost
-                             ? T_curr_prev_predicted
-                             : inverse(registration.getFinalTransformation().cast<double>());
+    result.T_curr_prev =
+        result.lost ? T_curr_prev_predicted
+                    : inverse(registration.getFinalTransformation().cast<double>());
     result.times.registration_ms = millisecondsSince(registration_start);
   }
 
   /// Registers on the given static pixels; true when it converged.
-  bool
-  align(const pcl::IndicesPtr& static_indices, const Eigen::Matrix4d& T_prev_curr_guess)
+  bool align(const pcl::IndicesPtr& static_indices,
+             const Eigen::Matrix4d& T_prev_curr_guess)
   {
     registration.setIndices(static_indices);
     Cloud aligned;
@@ -151,18 +155,17 @@ struct OdometryPipeline::Impl {
 
   /// Centre pixels of the valid cells whose flow agrees with T_prev_curr within
   /// static_consensus * th_inlier (squared transfer error of b_i onto a_i).
-  pcl::IndicesPtr
-  consensusCells(const pcl::PointCloud<PointFlow>& flow,
-                 std::uint32_t image_width,
-                 const Eigen::Matrix4d& T_prev_curr) const
+  pcl::IndicesPtr consensusCells(const pcl::PointCloud<PointFlow>& flow,
+                                 std::uint32_t image_width,
+                                 const Eigen::Matrix4d& T_prev_curr) const
   {
     const double limit = options.static_consensus * options.registration.th_inlier;
     auto indices = pcl::make_shared<pcl::Indices>();
     for (const PointFlow& cell : flow)
       if (cell.valid_3d &&
-          squaredTransferError(T_prev_curr, cell.getVector3fMap().cast<double>(),
-                               Eigen::Vector3d(cell.prev_x, cell.prev_y, cell.prev_z)) <=
-              limit)
+          squaredTransferError(
+              T_prev_curr, cell.getVector3fMap().cast<double>(),
+              Eigen::Vector3d(cell.prev_x, cell.prev_y, cell.prev_z)) <= limit)
         indices->push_back(static_cast<int>(cell.v) * static_cast<int>(image_width) +
                            static_cast<int>(cell.u));
     return indices;
@@ -180,8 +183,9 @@ struct OdometryPipeline::Impl {
 };
 
 OdometryPipeline::OdometryPipeline(const PipelineOptions& options)
-: impl_(std::make_unique<Impl>(options))
-{}
+    : impl_(std::make_unique<Impl>(options))
+{
+}
 
 OdometryPipeline::~OdometryPipeline() = default;
 
@@ -216,8 +220,9 @@ OdometryPipeline::process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& clo
       orthonormalize(result.T_world_curr);
     p.T_curr_prev_predicted = result.T_curr_prev;
   }
-  result.labels =
-      paintLabelImage(result.segments, result.segment_labels, result.width, result.height).data;
+  result.labels = paintLabelImage(result.segments, result.segment_labels, result.width,
+                                  result.height)
+                      .data;
   p.T_world_prev = result.T_world_curr;
   p.previous = cloud;
   ++p.frames;

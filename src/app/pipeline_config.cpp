@@ -105,7 +105,8 @@ loadPipelineConfig(const std::string& path, PipelineOptions& options)
   const auto fail = [&](const std::string& key, const std::string& problem) {
     throw pcl::IOException(path + ": " + key + ": " + problem);
   };
-  visitFields(options, [&](const std::string& section, const std::string& name, auto& field) {
+  visitFields(options, [&](const std::string& section, const std::string& name,
+                           auto& field) {
     using Field = std::decay_t<decltype(field)>;
     const std::string key = section + "." + name;
     known.insert(key);
@@ -148,7 +149,8 @@ loadPipelineConfig(const std::string& path, PipelineOptions& options)
   const std::function<void(const cv::FileNode&, const std::string&)> check =
       [&](const cv::FileNode& node, const std::string& prefix) {
         for (const auto& child : node) {
-          const std::string key = prefix.empty() ? child.name() : prefix + "." + child.name();
+          const std::string key =
+              prefix.empty() ? child.name() : prefix + "." + child.name();
           if (!known.count(key))
             fail(key, "unknown key");
           if (child.isMap())
@@ -179,12 +181,14 @@ writePipelineConfig(const std::string& path, const PipelineOptions& options)
     throw pcl::IOException(path + ": cannot write configuration file");
   PipelineOptions copy = options;
   std::string open_section;
-  visitFields(copy, [&](const std::string& section, const std::string& name, auto& field) {
+  visitFields(copy, [&](const std::string& section, const std::string& name,
+                        auto& field) {
     using Field = std::decay_t<decltype(field)>;
     if (section != open_section) {
       // Close the previous map(s) and open the new one(s); "a.b" nests b inside a.
       const auto depth = [](const std::string& s) {
-        return s.empty() ? 0 : 1 + static_cast<int>(std::count(s.begin(), s.end(), '.'));
+        return s.empty() ? 0
+                         : 1 + static_cast<int>(std::count(s.begin(), s.end(), '.'));
       };
       const std::string parent = section.substr(0, section.find('.'));
       const bool stays_in_parent = open_section.rfind(parent, 0) == 0;
@@ -203,7 +207,8 @@ writePipelineConfig(const std::string& path, const PipelineOptions& options)
     else
       fs << name << static_cast<double>(field);
   });
-  for (int d = 1 + static_cast<int>(std::count(open_section.begin(), open_section.end(), '.'));
+  for (int d = 1 + static_cast<int>(
+                       std::count(open_section.begin(), open_section.end(), '.'));
        d > 0; --d)
     fs << "}";
   fs.release();

@@ -40,10 +40,10 @@ RunOutputs::RunOutputs(const std::string& trajectory_path,
                        const std::string& labels_dir,
                        const std::string& objects_path,
                        const Trajectory* initial_groundtruth)
-: trajectory_path_(trajectory_path)
-, labels_dir_(labels_dir)
-, objects_path_(objects_path)
-, initial_groundtruth_(initial_groundtruth)
+    : trajectory_path_(trajectory_path)
+    , labels_dir_(labels_dir)
+    , objects_path_(objects_path)
+    , initial_groundtruth_(initial_groundtruth)
 {
   if (!labels_dir_.empty()) {
     std::error_code error;
@@ -66,8 +66,8 @@ RunOutputs::add(const FrameResult& result)
     std::vector<double> stamps;
     for (const auto& pose : *initial_groundtruth_)
       stamps.push_back(pose.timestamp);
-    T_world_start_ =
-        (*initial_groundtruth_)[findClosestIndex(stamps, result.timestamp)].T_world_camera;
+    T_world_start_ = (*initial_groundtruth_)[findClosestIndex(stamps, result.timestamp)]
+                         .T_world_camera;
   }
   StampedPose pose;
   pose.timestamp = result.timestamp;
@@ -80,7 +80,8 @@ RunOutputs::add(const FrameResult& result)
   if (objects_.is_open()) {
     for (std::size_t s = 1; s < result.segments.size(); ++s)
       objects_ << formatObjectMotionLine(result.timestamp, result.segment_labels[s],
-                                         result.segments[s].indices.size(), result.motions[s])
+                                         result.segments[s].indices.size(),
+                                         result.motions[s])
                << '\n';
     if (!objects_)
       throw pcl::IOException(objects_path_ + ": write failed");
@@ -97,13 +98,16 @@ RunOutputs::finish()
     std::error_code error;
     fs::rename(partial(objects_path_), objects_path_, error);
     if (error)
-      throw pcl::IOException(objects_path_ + ": cannot move the written file into place");
+      throw pcl::IOException(objects_path_ +
+                             ": cannot move the written file into place");
   }
 }
 
 RunReport::RunReport(std::size_t expected_frames)
-: expected_frames_(expected_frames), terminal_(::isatty(STDERR_FILENO) == 1)
-{}
+    : expected_frames_(expected_frames)
+    , terminal_(::isatty(STDERR_FILENO) == 1)
+{
+}
 
 void
 RunReport::add(const FrameResult& result)
@@ -118,13 +122,14 @@ RunReport::add(const FrameResult& result)
   ++frames_;
   if (terminal_) {
     const int width = 40;
-    const int done = expected_frames_ > 0
-                         ? static_cast<int>(width * std::min(frames_, expected_frames_) /
-                                            expected_frames_)
-                         : 0;
-    std::fprintf(stderr, "\r[%s%s] %zu/%zu frames, %.1f ms", std::string(done, '#').c_str(),
-                 std::string(width - done, ' ').c_str(), frames_, expected_frames_,
-                 result.times.total_ms);
+    const int done =
+        expected_frames_ > 0
+            ? static_cast<int>(width * std::min(frames_, expected_frames_) /
+                               expected_frames_)
+            : 0;
+    std::fprintf(stderr, "\r[%s%s] %zu/%zu frames, %.1f ms",
+                 std::string(done, '#').c_str(), std::string(width - done, ' ').c_str(),
+                 frames_, expected_frames_, result.times.total_ms);
     std::fflush(stderr);
   }
 }
@@ -142,15 +147,16 @@ RunReport::printSummary(const std::string& accuracy) const
               median(flow_ms_), median(segmentation_ms_), median(registration_ms_));
   if (!accuracy.empty())
     std::printf("%s\n", accuracy.c_str());
-  std::printf("frames=%zu lost=%zu median_ms=%.2f mean_ms=%.2f fps=%.1f\n", frames_, lost_,
-              median(total_ms_), mean, mean > 0.0 ? 1000.0 / mean : 0.0);
+  std::printf("frames=%zu lost=%zu median_ms=%.2f mean_ms=%.2f fps=%.1f\n", frames_,
+              lost_, median(total_ms_), mean, mean > 0.0 ? 1000.0 / mean : 0.0);
 }
 
 std::string
 RunReport::accuracy(const Trajectory& groundtruth, const Trajectory& estimate)
 {
   try {
-    return formatMetrics(computeRpe(groundtruth, estimate), computeAte(groundtruth, estimate));
+    return formatMetrics(computeRpe(groundtruth, estimate),
+                         computeAte(groundtruth, estimate));
   }
   catch (const std::invalid_argument& e) {
     return std::string("accuracy not available: ") + e.what();

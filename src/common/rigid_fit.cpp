@@ -14,10 +14,11 @@ RigidFitAccumulator::add(const Eigen::Vector3d& source,
                          const Eigen::Vector3d& target,
                          double weight)
 {
-  if (!source.allFinite() || !target.allFinite() || !std::isfinite(weight) || weight < 0.0)
-    throw std::invalid_argument(
-        "[dynvo::RigidFitAccumulator::add] points must be finite and the weight finite and "
-        ">= 0");
+  if (!source.allFinite() || !target.allFinite() || !std::isfinite(weight) ||
+      weight < 0.0)
+    throw std::invalid_argument("[dynvo::RigidFitAccumulator::add] points must be "
+                                "finite and the weight finite and "
+                                ">= 0");
   if (weight == 0.0)
     return;
   if (count_ == 0) {
@@ -50,14 +51,16 @@ RigidFitAccumulator::solve(Eigen::Matrix4d& T_target_source) const
   const Eigen::Vector3d target_mean = target_sum_ / weight_sum_;
   const Eigen::Matrix3d M =
       cross_sum_ - weight_sum_ * target_mean * source_mean.transpose();
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(M, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(M, Eigen::ComputeFullU |
+                                                     Eigen::ComputeFullV);
   const Eigen::Vector3d& s = svd.singularValues();
   if (!(s(0) > 0.0) || s(1) < 1e-9 * s(0))
     return RigidFitStatus::degenerate;
   Eigen::Vector3d guard = Eigen::Vector3d::Ones();
   if (svd.matrixU().determinant() * svd.matrixV().determinant() < 0.0)
     guard(2) = -1.0;
-  const Eigen::Matrix3d R = svd.matrixU() * guard.asDiagonal() * svd.matrixV().transpose();
+  const Eigen::Matrix3d R =
+      svd.matrixU() * guard.asDiagonal() * svd.matrixV().transpose();
   T_target_source.setIdentity();
   T_target_source.topLeftCorner<3, 3>() = R;
   T_target_source.topRightCorner<3, 1>() =

@@ -27,8 +27,8 @@ associateTimestamps(const std::vector<double>& first,
 
   std::vector<std::tuple<double, std::size_t, std::size_t>> candidates;
   for (std::size_t i = 0; i < first.size(); ++i) {
-    auto it = std::lower_bound(
-        sorted_second.begin(), sorted_second.end(), first[i] - max_difference);
+    auto it = std::lower_bound(sorted_second.begin(), sorted_second.end(),
+                               first[i] - max_difference);
     for (; it != sorted_second.end() && *it <= first[i] + max_difference; ++it) {
       const double diff = std::abs(first[i] - *it);
       if (diff < max_difference)

@@ -36,10 +36,13 @@ median(std::vector<double> values)
 } // namespace
 
 RpeResult
-computeRpe(const Trajectory& groundtruth, const Trajectory& estimate, const RpeOptions& options)
+computeRpe(const Trajectory& groundtruth,
+           const Trajectory& estimate,
+           const RpeOptions& options)
 {
   if (groundtruth.size() < 2 || estimate.size() < 2)
-    throw std::invalid_argument("[dynvo::computeRpe] both trajectories need at least 2 poses");
+    throw std::invalid_argument(
+        "[dynvo::computeRpe] both trajectories need at least 2 poses");
   if (!(options.delta > 0.0))
     throw std::invalid_argument("[dynvo::computeRpe] delta must be positive");
 
@@ -96,15 +99,16 @@ computeRpe(const Trajectory& groundtruth, const Trajectory& estimate, const RpeO
 }
 
 AteResult
-computeAte(const Trajectory& groundtruth, const Trajectory& estimate, double max_difference)
+computeAte(const Trajectory& groundtruth,
+           const Trajectory& estimate,
+           double max_difference)
 {
   const auto matches =
       associateTimestamps(stampsOf(estimate), stampsOf(groundtruth), max_difference);
   if (matches.size() < 3)
-    throw std::invalid_argument("[dynvo::computeAte] only " +
-                                std::to_string(matches.size()) +
-                                " stamps associate within " +
-                                std::to_string(max_difference) + " s; need 3");
+    throw std::invalid_argument(
+        "[dynvo::computeAte] only " + std::to_string(matches.size()) +
+        " stamps associate within " + std::to_string(max_difference) + " s; need 3");
   Eigen::Matrix3Xd est(3, matches.size()), gt(3, matches.size());
   for (std::size_t k = 0; k < matches.size(); ++k) {
     est.col(k) = estimate[matches[k].first].T_world_camera.translation();
@@ -134,13 +138,14 @@ std::string
 formatMetrics(const RpeResult& rpe, const AteResult& ate, bool json)
 {
   const char* format =
-      json ? "{\"rpe_trans_rmse\": %.6f, \"rpe_trans_mean\": %.6f, \"rpe_rot_rmse\": %.6f, "
+      json ? "{\"rpe_trans_rmse\": %.6f, \"rpe_trans_mean\": %.6f, \"rpe_rot_rmse\": "
+             "%.6f, "
              "\"ate_rmse\": %.6f, \"pairs\": %zu}"
            : "rpe_trans_rmse=%.6f rpe_trans_mean=%.6f rpe_rot_rmse=%.6f ate_rmse=%.6f "
              "pairs=%zu";
   char line[256];
-  std::snprintf(line, sizeof(line), format, rpe.trans_rmse, rpe.trans_mean, rpe.rot_rmse,
-                ate.rmse, rpe.pairs);
+  std::snprintf(line, sizeof(line), format, rpe.trans_rmse, rpe.trans_mean,
+                rpe.rot_rmse, ate.rmse, rpe.pairs);
   return line;
 }
 

@@ -17,8 +17,8 @@ makeOrganizedCloud(const ColorImage& color,
         "[dynvo::makeOrganizedCloud] colour image is " + std::to_string(color.width) +
         "x" + std::to_string(color.height) + " but depth image is " +
         std::to_string(depth.width) + "x" + std::to_string(depth.height));
-  auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZRGB>>(color.width,
-                                                                    color.height);
+  auto cloud =
+      pcl::make_shared<pcl::PointCloud<pcl::PointXYZRGB>>(color.width, color.height);
   cloud->is_dense = false;
   const float nan = std::numeric_limits<float>::quiet_NaN();
   for (std::uint32_t v = 0; v < color.height; ++v) {
@@ -30,8 +30,8 @@ makeOrganizedCloud(const ColorImage& color,
       p.b = color.data[3 * i + 2];
       const float z = depth.data[i];
       if (std::isfinite(z) && z > 0.0f)
-        p.getVector3fMap() = intrinsics.backproject(static_cast<float>(u),
-                                                    static_cast<float>(v), z);
+        p.getVector3fMap() =
+            intrinsics.backproject(static_cast<float>(u), static_cast<float>(v), z);
       else
         p.x = p.y = p.z = nan;
     }

@@ -18,7 +18,8 @@ paintLabelImage(const std::vector<pcl::PointIndices>& segments,
                 std::uint32_t width,
                 std::uint32_t height)
 {
-  LabelImage image{width, height, std::vector<std::uint8_t>(std::size_t{width} * height, 0)};
+  LabelImage image{width, height,
+                   std::vector<std::uint8_t>(std::size_t{width} * height, 0)};
   for (std::size_t s = 0; s < segments.size() && s < labels.size(); ++s)
     for (const auto index : segments[s].indices)
       image.data.at(index) = labels[s];
@@ -38,8 +39,8 @@ writeLabelImage(const std::string& path, const LabelImage& labels)
 {
   if (labels.data.size() != static_cast<std::size_t>(labels.width) * labels.height)
     throw pcl::IOException(path + ": label image data does not match its size");
-  const cv::Mat image(static_cast<int>(labels.height), static_cast<int>(labels.width), CV_8UC1,
-                      const_cast<std::uint8_t*>(labels.data.data()));
+  const cv::Mat image(static_cast<int>(labels.height), static_cast<int>(labels.width),
+                      CV_8UC1, const_cast<std::uint8_t*>(labels.data.data()));
   bool written = false;
   try {
     written = cv::imwrite(path, image);
@@ -79,8 +80,8 @@ formatObjectMotionLine(double timestamp,
     q.coeffs() = -q.coeffs();
   const Eigen::Vector3f t = T_curr_prev.topRightCorner<3, 1>();
   char line[256];
-  std::snprintf(line, sizeof(line), "%.6f %d %zu %.6f %.6f %.6f %.9f %.9f %.9f %.9f", timestamp,
-                id, pixels, t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
+  std::snprintf(line, sizeof(line), "%.6f %d %zu %.6f %.6f %.6f %.9f %.9f %.9f %.9f",
+                timestamp, id, pixels, t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
   return line;
 }
 

@@ -135,8 +135,7 @@ struct OniFileSource::Impl {
   unsigned depth_height = 0; ///< depth stream rows (px)
 
   /// OpenNI thread: remembers a failure for next(); exceptions must not reach OpenNI.
-  void
-  setError(const std::string& message)
+  void setError(const std::string& message)
   {
     {
       std::lock_guard<std::mutex> lock(mutex);
@@ -148,8 +147,7 @@ struct OniFileSource::Impl {
 
   /// OpenNI thread: a depth frame arrived. Its pixels are copied at once, so no
   /// OpenNI frame buffer is held beyond the callback.
-  void
-  onDepth(const pcl::io::DepthImage::Ptr& image)
+  void onDepth(const pcl::io::DepthImage::Ptr& image)
   {
     auto depth = std::make_shared<RawDepth>();
     try {
@@ -189,8 +187,7 @@ struct OniFileSource::Impl {
   }
 
   /// OpenNI thread: a colour frame arrived (copied at once, see onDepth()).
-  void
-  onImage(const pcl::io::Image::Ptr& frame)
+  void onImage(const pcl::io::Image::Ptr& frame)
   {
     auto image = std::make_shared<RawColor>();
     try {
@@ -221,8 +218,7 @@ struct OniFileSource::Impl {
   /// Asks the player (in manual mode) for the next record. waitForAnyStream() pokes
   /// the device when no frame is pending; the grabber's listeners then read the frame
   /// and call onDepth()/onImage(). Timeout 0: one poke, no waiting here.
-  void
-  step()
+  void step()
   {
     int ready = -1;
     openni::OpenNI::waitForAnyStream(streams.data(), static_cast<int>(streams.size()),
@@ -231,8 +227,7 @@ struct OniFileSource::Impl {
 
   /// True when the front depth frame can be paired: a colour frame at or after its
   /// time has arrived, or no further colour frame will come.
-  bool
-  pairReady() const
+  bool pairReady() const
   {
     if (depths.empty() || images.empty())
       return false;
@@ -242,8 +237,7 @@ struct OniFileSource::Impl {
   }
 
   /// Pops the front depth frame with the colour frame nearest in time (lock held).
-  std::pair<DepthPtr, ImagePtr>
-  takePair()
+  std::pair<DepthPtr, ImagePtr> takePair()
   {
     DepthPtr depth = depths.front();
     depths.pop_front();
@@ -258,8 +252,7 @@ struct OniFileSource::Impl {
     return {depth, images.front()};
   }
 
-  void
-  stop() noexcept
+  void stop() noexcept
   {
     {
       std::lock_guard<std::mutex> lock(mutex);
@@ -278,7 +271,8 @@ struct OniFileSource::Impl {
   }
 };
 
-OniFileSource::OniFileSource(const std::string& file) : impl_(std::make_unique<Impl>())
+OniFileSource::OniFileSource(const std::string& file)
+    : impl_(std::make_unique<Impl>())
 {
   impl_->file = file;
   checkOniHeader(file);
@@ -330,9 +324,13 @@ OniFileSource::OniFileSource(const std::string& file) : impl_(std::make_unique<I
     // Separate image and depth signals, paired here: the grabber's own
     // image+depth synchronizer holds back the last pair of a recording.
     std::function<pcl::io::OpenNI2Grabber::sig_cb_openni_depth_image> on_depth =
-        [&impl](const pcl::io::DepthImage::Ptr& depth) { impl.onDepth(depth); };
+        [&impl](const pcl::io::DepthImage::Ptr& depth) {
+          impl.onDepth(depth);
+        };
     std::function<pcl::io::OpenNI2Grabber::sig_cb_openni_image> on_image =
-        [&impl](const pcl::io::Image::Ptr& image) { impl.onImage(image); };
+        [&impl](const pcl::io::Image::Ptr& image) {
+          impl.onImage(image);
+        };
     impl.grabber->registerCallback(on_depth);
     impl.grabber->registerCallback(on_image);
     impl.grabber->start();

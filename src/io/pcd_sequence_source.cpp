@@ -75,11 +75,12 @@ naturalLess(const std::string& a, const std::string& b)
   return a < b;
 }
 
-PcdSequenceSource::PcdSequenceSource(const std::string& folder, double fps) : fps_(fps)
+PcdSequenceSource::PcdSequenceSource(const std::string& folder, double fps)
+    : fps_(fps)
 {
   if (!(fps > 0.0) || !std::isfinite(fps))
-    throw std::invalid_argument("[dynvo::PcdSequenceSource] fps must be positive, got " +
-                                std::to_string(fps));
+    throw std::invalid_argument(
+        "[dynvo::PcdSequenceSource] fps must be positive, got " + std::to_string(fps));
   if (!fs::is_directory(folder))
     throw pcl::IOException(folder + ": not a directory");
   for (const auto& entry : fs::directory_iterator(folder))
@@ -88,12 +89,14 @@ PcdSequenceSource::PcdSequenceSource(const std::string& folder, double fps) : fp
   if (files_.empty())
     throw pcl::IOException(folder + ": no .pcd file");
   // Timestamp names sort by value ("1.25" before "1.5"), any other name naturally.
-  std::sort(files_.begin(), files_.end(), [](const std::string& a, const std::string& b) {
-    const double ta = stampFromName(a), tb = stampFromName(b);
-    if (std::isfinite(ta) && std::isfinite(tb) && ta != tb)
-      return ta < tb;
-    return naturalLess(fs::path(a).filename().string(), fs::path(b).filename().string());
-  });
+  std::sort(files_.begin(), files_.end(),
+            [](const std::string& a, const std::string& b) {
+              const double ta = stampFromName(a), tb = stampFromName(b);
+              if (std::isfinite(ta) && std::isfinite(tb) && ta != tb)
+                return ta < tb;
+              return naturalLess(fs::path(a).filename().string(),
+                                 fs::path(b).filename().string());
+            });
 }
 
 bool
@@ -111,8 +114,8 @@ PcdSequenceSource::next(Frame& frame)
   Eigen::Quaternionf orientation;
   int version = 0, data_type = 0;
   unsigned int data_index = 0;
-  if (reader.readHeader(file, blob, origin, orientation, version, data_type, data_index) !=
-          0 ||
+  if (reader.readHeader(file, blob, origin, orientation, version, data_type,
+                        data_index) != 0 ||
       blob.fields.empty() || blob.width * blob.height == 0)
     throw pcl::IOException(file + ": cannot read PCD file (missing or corrupt header)");
   if (reader.read(file, blob) != 0)
@@ -122,7 +125,9 @@ PcdSequenceSource::next(Frame& frame)
                            std::to_string(blob.height) + ")");
   const auto has_field = [&](const std::string& name) {
     return std::any_of(blob.fields.begin(), blob.fields.end(),
-                       [&](const pcl::PCLPointField& f) { return f.name == name; });
+                       [&](const pcl::PCLPointField& f) {
+                         return f.name == name;
+                       });
   };
   if (!has_field("x") || !has_field("y") || !has_field("z"))
     throw pcl::IOException(file + ": cloud has no x, y, z fields");

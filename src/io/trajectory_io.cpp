@@ -47,8 +47,9 @@ readTrajectory(const std::string& path)
       values.push_back(value);
     }
     if (values.size() != 8)
-      throw pcl::IOException(where + "expected 8 numbers (timestamp tx ty tz qx qy qz "
-                                     "qw), got " +
+      throw pcl::IOException(where +
+                             "expected 8 numbers (timestamp tx ty tz qx qy qz "
+                             "qw), got " +
                              std::to_string(values.size()));
     if (!trajectory.empty() && !(values[0] > trajectory.back().timestamp))
       throw pcl::IOException(where + "timestamp " + std::to_string(values[0]) +
@@ -61,7 +62,8 @@ readTrajectory(const std::string& path)
     StampedPose pose;
     pose.timestamp = values[0];
     pose.T_world_camera.linear() = q.toRotationMatrix();
-    pose.T_world_camera.translation() = Eigen::Vector3d(values[1], values[2], values[3]);
+    pose.T_world_camera.translation() =
+        Eigen::Vector3d(values[1], values[2], values[3]);
     trajectory.push_back(pose);
   }
   return trajectory;

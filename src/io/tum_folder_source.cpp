@@ -60,7 +60,8 @@ parseStamp(const std::string& token, const fs::path& path, int line)
     used = 0;
   }
   if (used != token.size() || !std::isfinite(stamp))
-    fail(path.string() + ":" + std::to_string(line) + ": bad timestamp '" + token + "'");
+    fail(path.string() + ":" + std::to_string(line) + ": bad timestamp '" + token +
+         "'");
   return stamp;
 }
 
@@ -98,7 +99,8 @@ readColor(const fs::path& path)
   const int channels = image.channels();
   for (int v = 0; v < image.rows; ++v) {
     const std::uint8_t* row = image.ptr<std::uint8_t>(v);
-    std::uint8_t* out = color.data.data() + 3 * static_cast<std::size_t>(v) * image.cols;
+    std::uint8_t* out =
+        color.data.data() + 3 * static_cast<std::size_t>(v) * image.cols;
     for (int u = 0; u < image.cols; ++u) {
       // OpenCV stores BGR(A).
       out[3 * u] = row[channels * u + 2];
@@ -137,11 +139,13 @@ readDepth(const fs::path& path, double depth_scale)
 } // namespace
 
 TumFolderSource::TumFolderSource(const std::string& folder, const Options& options)
-: folder_(folder), options_(options)
+    : folder_(folder)
+    , options_(options)
 {
   options_.intrinsics.validate();
   if (!(options_.depth_scale >= 0.0) || !std::isfinite(options_.depth_scale))
-    throw std::invalid_argument("[dynvo::TumFolderSource] depth scale must be positive");
+    throw std::invalid_argument(
+        "[dynvo::TumFolderSource] depth scale must be positive");
   const fs::path dir(folder);
   if (!fs::is_directory(dir))
     fail(folder + ": not a directory");
@@ -155,10 +159,8 @@ TumFolderSource::TumFolderSource(const std::string& folder, const Options& optio
       if (!(tokens >> t_rgb >> rgb >> t_depth >> depth))
         fail(associations.string() + ":" + std::to_string(number) +
              ": expected 't_rgb rgb_file t_depth depth_file'");
-      entries_.push_back({parseStamp(t_rgb, associations, number),
-                          rgb,
-                          parseStamp(t_depth, associations, number),
-                          depth});
+      entries_.push_back({parseStamp(t_rgb, associations, number), rgb,
+                          parseStamp(t_depth, associations, number), depth});
     }
   }
   else {
@@ -193,7 +195,8 @@ TumFolderSource::read(std::size_t i) const
   frame.name = (dir / entry.rgb_file).string();
   frame.color = readColor(dir / entry.rgb_file);
   frame.depth = readDepth(dir / entry.depth_file, depth_scale_);
-  if (frame.color.width != frame.depth.width || frame.color.height != frame.depth.height)
+  if (frame.color.width != frame.depth.width ||
+      frame.color.height != frame.depth.height)
     fail((dir / entry.depth_file).string() + ": depth image size differs from " +
          entry.rgb_file);
   frame.cloud = makeOrganizedCloud(frame.color, frame.depth, options_.intrinsics);

@@ -60,8 +60,7 @@ struct LatticeCell {
     sy = quinticFade(y - fy);
   }
 
-  float
-  blend(float v00, float v10, float v01, float v11) const
+  float blend(float v00, float v10, float v01, float v11) const
   {
     const float bottom = v00 + sx * (v10 - v00);
     const float top = v01 + sx * (v11 - v01);
@@ -78,7 +77,8 @@ valueNoise(float x, float y, std::uint32_t salt)
   return c.blend(static_cast<float>(latticeHash(c.ix, c.iy, salt) >> 8) * TO_UNIT,
                  static_cast<float>(latticeHash(c.ix + 1, c.iy, salt) >> 8) * TO_UNIT,
                  static_cast<float>(latticeHash(c.ix, c.iy + 1, salt) >> 8) * TO_UNIT,
-                 static_cast<float>(latticeHash(c.ix + 1, c.iy + 1, salt) >> 8) * TO_UNIT);
+                 static_cast<float>(latticeHash(c.ix + 1, c.iy + 1, salt) >> 8) *
+                     TO_UNIT);
 }
 
 /// Colour value noise: three independent channels in [0, 1] from one hash per corner.
@@ -87,10 +87,9 @@ colourNoise(float x, float y, std::uint32_t salt, float rgb[3])
 {
   constexpr float TO_UNIT = 1.0f / 1023.0f;
   const LatticeCell c(x, y);
-  const std::uint32_t h[4] = {latticeHash(c.ix, c.iy, salt),
-                              latticeHash(c.ix + 1, c.iy, salt),
-                              latticeHash(c.ix, c.iy + 1, salt),
-                              latticeHash(c.ix + 1, c.iy + 1, salt)};
+  const std::uint32_t h[4] = {
+      latticeHash(c.ix, c.iy, salt), latticeHash(c.ix + 1, c.iy, salt),
+      latticeHash(c.ix, c.iy + 1, salt), latticeHash(c.ix + 1, c.iy + 1, salt)};
   for (int channel = 0; channel < 3; ++channel) {
     const int shift = 10 * channel;
     rgb[channel] = c.blend(static_cast<float>((h[0] >> shift) & 1023U) * TO_UNIT,
@@ -142,14 +141,16 @@ surfaceAlbedo(float x,
     if (weight == 0.0f)
       break; // every finer octave has faded out as well
     const float inv = 1.0f / LATTICE[octave];
-    luminance += AMPLITUDE[octave] * weight *
-                 (valueNoise(x * inv, y * inv, salt + 0x632be5abU * (octave + 1)) - 0.5f);
+    luminance +=
+        AMPLITUDE[octave] * weight *
+        (valueNoise(x * inv, y * inv, salt + 0x632be5abU * (octave + 1)) - 0.5f);
   }
   const float gain = 1.0f + 1.6f * luminance;
   for (int channel = 0; channel < 3; ++channel) {
     const float patches = 0.6f * (0.5f + w_coarse * (coarse[channel] - 0.5f)) +
                           0.4f * (0.5f + w_mid * (mid[channel] - 0.5f));
-    rgb[channel] = std::clamp(base[channel] * (0.35f + 0.65f * patches) * gain, 0.0f, 1.0f);
+    rgb[channel] =
+        std::clamp(base[channel] * (0.35f + 0.65f * patches) * gain, 0.0f, 1.0f);
   }
 }
 

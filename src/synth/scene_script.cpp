@@ -83,54 +83,63 @@ makeScenarios()
   using V = Eigen::Vector3d;
   std::vector<Scenario> scenarios;
 
-  scenarios.push_back({"static_one", "static camera, one box circling in the room",
-                       staticCamera(),
-                       {ellipticBox(1, V(0.25, 0.25, 0.25), V(0.0, 0.3, 1.4),
-                                    ellipse(V(0.6, 0.0, 0.0), V(0.0, 0.0, 0.3), 0.7, 0.0),
-                                    0.6)}});
+  scenarios.push_back(
+      {"static_one",
+       "static camera, one box circling in the room",
+       staticCamera(),
+       {ellipticBox(1, V(0.25, 0.25, 0.25), V(0.0, 0.3, 1.4),
+                    ellipse(V(0.6, 0.0, 0.0), V(0.0, 0.0, 0.3), 0.7, 0.0), 0.6)}});
   scenarios.back().objects[0].path.translation.push_back({V(0.0, 0.1, 0.0), 1.3, 0.0});
 
   scenarios.push_back(
-      {"static_two", "static camera, two boxes moving independently", staticCamera(),
+      {"static_two",
+       "static camera, two boxes moving independently",
+       staticCamera(),
        {ellipticBox(1, V(0.22, 0.22, 0.22), V(-0.3, 0.3, 1.4),
                     ellipse(V(0.4, 0.0, 0.0), V(0.0, 0.0, 0.25), 1.0, 0.0), 0.7),
         ellipticBox(2, V(0.3, 0.15, 0.2), V(0.3, 0.0, 1.6),
                     ellipse(V(0.4, 0.0, 0.0), V(0.0, 0.3, 0.0), 1.1, 1.0), 0.0)}});
 
   scenarios.push_back(
-      {"moving_crossing", "moving camera, a box entering from the left and crossing back and forth",
+      {"moving_crossing",
+       "moving camera, a box entering from the left and crossing back and forth",
        movingCamera(1.0),
        {ellipticBox(1, V(0.3, 0.3, 0.3), V(0.0, 0.0, 1.35),
-                    ellipse(V(1.2, 0.0, 0.0), V(0.0, 0.0, 0.2), 0.55, -HALF_PI), 0.5)}});
+                    ellipse(V(1.2, 0.0, 0.0), V(0.0, 0.0, 0.2), 0.55, -HALF_PI),
+                    0.5)}});
 
   // The box travels along the mean optical axis from 1.8 m to 0.7 m (front face at
   // about 0.35 m, covering most of the image) and back, every 10.5 s.
   ScriptedBox occluder{1, V(0.35, 0.35, 0.35), {}, {}};
   occluder.path.base_rotation = cameraBaseRotation();
   occluder.path.centre = cameraBaseRotation() * V(0.05, 0.0, 1.25);
-  occluder.path.translation = {{cameraBaseRotation() * V(0.0, 0.0, 0.55), 0.6, HALF_PI}};
-  occluder.path.rotation = {{V(0.1, 0.0, 0.0), 0.8, 0.0}, {V(0.0, 0.15, 0.0), 0.5, 0.3}};
-  scenarios.push_back({"moving_occluder",
-                       "moving camera, a box approaching until it covers most of the image",
-                       movingCamera(0.5),
-                       {occluder}});
+  occluder.path.translation = {
+      {cameraBaseRotation() * V(0.0, 0.0, 0.55), 0.6, HALF_PI}};
+  occluder.path.rotation = {{V(0.1, 0.0, 0.0), 0.8, 0.0},
+                            {V(0.0, 0.15, 0.0), 0.5, 0.3}};
+  scenarios.push_back(
+      {"moving_occluder",
+       "moving camera, a box approaching until it covers most of the image",
+       movingCamera(0.5),
+       {occluder}});
 
-  ScriptedBox first = ellipticBox(1, V(0.25, 0.25, 0.25), V(-0.45, 0.35, 1.3),
-                                  ellipse(V(0.25, 0.0, 0.0), V(0.0, 0.0, 0.2), 1.2, 0.0),
-                                  0.5);
+  ScriptedBox first =
+      ellipticBox(1, V(0.25, 0.25, 0.25), V(-0.45, 0.35, 1.3),
+                  ellipse(V(0.25, 0.0, 0.0), V(0.0, 0.0, 0.2), 1.2, 0.0), 0.5);
   first.schedule = {10.0, {{2.0, 4.0}, {6.5, 8.5}}, 0.25};
-  ScriptedBox second = ellipticBox(2, V(0.2, 0.3, 0.2), V(0.45, 0.1, 1.6),
-                                   ellipse(V(0.25, 0.0, 0.0), V(0.0, -0.25, 0.0), 1.3, 0.0),
-                                   0.4);
+  ScriptedBox second =
+      ellipticBox(2, V(0.2, 0.3, 0.2), V(0.45, 0.1, 1.6),
+                  ellipse(V(0.25, 0.0, 0.0), V(0.0, -0.25, 0.0), 1.3, 0.0), 0.4);
   second.schedule = {10.0, {{0.5, 2.5}, {5.0, 6.5}}, 0.25};
   scenarios.push_back({"stop_and_go",
                        "moving camera, two boxes resting for stretches, then moved",
                        movingCamera(0.6),
                        {first, second}});
 
-  scenarios.push_back(
-      {"moving_static", "moving camera in a static room (no moving object)",
-       movingCamera(1.0), {}});
+  scenarios.push_back({"moving_static",
+                       "moving camera in a static room (no moving object)",
+                       movingCamera(1.0),
+                       {}});
   return scenarios;
 }
 
@@ -164,9 +173,10 @@ RigidPath::pose(double s) const
   for (const SineTerm& term : rotation)
     rotation_vector += term.amplitude * std::sin(term.omega * s + term.phase);
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.linear() = base_rotation *
-                  Eigen::AngleAxisd(spin_rate * s, Eigen::Vector3d::UnitY()).toRotationMatrix() *
-                  expRotation(rotation_vector);
+  pose.linear() =
+      base_rotation *
+      Eigen::AngleAxisd(spin_rate * s, Eigen::Vector3d::UnitY()).toRotationMatrix() *
+      expRotation(rotation_vector);
   pose.translation() = translation_now;
   return pose;
 }
@@ -193,10 +203,11 @@ room()
   // Sized like an office corner seen by a hand-held Kinect (TUM fr1 scenes are mostly at
   // 1-2.5 m): the far wall is 2.2 m away, where the sensor's depth noise is about 6 mm.
   // Scripted boxes, tumbling included, never enter the walls or the furniture.
-  static const Room ROOM{Eigen::Vector3d(-2.0, -1.3, -1.0),
-                         Eigen::Vector3d(2.0, 1.0, 2.2),
-                         {{Eigen::Vector3d(-1.5, 0.8, 1.85), Eigen::Vector3d(0.4, 0.2, 0.35)},
-                          {Eigen::Vector3d(1.45, 0.85, 1.85), Eigen::Vector3d(0.35, 0.15, 0.35)}}};
+  static const Room ROOM{
+      Eigen::Vector3d(-2.0, -1.3, -1.0),
+      Eigen::Vector3d(2.0, 1.0, 2.2),
+      {{Eigen::Vector3d(-1.5, 0.8, 1.85), Eigen::Vector3d(0.4, 0.2, 0.35)},
+       {Eigen::Vector3d(1.45, 0.85, 1.85), Eigen::Vector3d(0.35, 0.15, 0.35)}}};
   return ROOM;
 }
 

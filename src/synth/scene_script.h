@@ -23,14 +23,13 @@ struct SineTerm {
  * rotation(s) = base_rotation * Ry(spin_rate s) * exp([sum of rotation terms]x).
  */
 struct RigidPath {
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();             ///< metres
-  Eigen::Matrix3d base_rotation = Eigen::Matrix3d::Identity();  ///< at s = 0
-  std::vector<SineTerm> translation;                            ///< metres
-  std::vector<SineTerm> rotation;                               ///< rotation vector (rad)
-  double spin_rate = 0.0;                                       ///< about local y (rad/s)
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();            ///< metres
+  Eigen::Matrix3d base_rotation = Eigen::Matrix3d::Identity(); ///< at s = 0
+  std::vector<SineTerm> translation;                           ///< metres
+  std::vector<SineTerm> rotation; ///< rotation vector (rad)
+  double spin_rate = 0.0;         ///< about local y (rad/s)
 
-  Eigen::Isometry3d
-  pose(double s) const;
+  Eigen::Isometry3d pose(double s) const;
 };
 
 /** \brief Maps time to motion progress. Without windows the object always moves
@@ -41,12 +40,11 @@ struct RigidPath {
  * can be decided by comparing progress values exactly.
  */
 struct MotionSchedule {
-  double period = 0.0;                              ///< seconds
-  std::vector<std::pair<double, double>> windows;   ///< [start, end] in [0, period] (s)
-  double ramp = 0.25;                               ///< seconds
+  double period = 0.0;                            ///< seconds
+  std::vector<std::pair<double, double>> windows; ///< [start, end] in [0, period] (s)
+  double ramp = 0.25;                             ///< seconds
 
-  double
-  progress(double t) const;
+  double progress(double t) const;
 };
 
 /// One scripted box; id is its label value.
@@ -78,11 +76,9 @@ struct Scenario {
 };
 
 /// The room (same for every scenario).
-const Room&
-room();
+const Room& room();
 
 /// Every scenario, in the fixed public order.
-const std::vector<Scenario>&
-allScenarios();
+const std::vector<Scenario>& allScenarios();
 
 } // namespace dynvo::detail

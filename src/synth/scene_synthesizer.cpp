@@ -24,7 +24,8 @@ constexpr float INF = std::numeric_limits<float>::infinity();
 constexpr double TWO_PI = 6.28318530717958647692;
 constexpr float AMBIENT = 0.45f; ///< light reaching faces turned away from the lamp
 constexpr float DIFFUSE = 0.55f; ///< Lambertian part at normal incidence
-constexpr float MIN_COSINE = 0.25f; ///< footprint growth is capped at 4x at grazing angles
+constexpr float MIN_COSINE =
+    0.25f; ///< footprint growth is capped at 4x at grazing angles
 constexpr int ROOM_SURFACES = 6;
 constexpr int FURNITURE_SURFACE_BASE = 6;
 constexpr int OBJECT_SURFACE_BASE = 64;
@@ -52,19 +53,20 @@ surfaceLook(std::uint32_t seed, int surface, const Eigen::Vector3d& normal_world
   for (int channel = 0; channel < 3; ++channel)
     look.base[channel] =
         0.5f + 0.5f * static_cast<float>((colour >> (8 * channel)) & 255U) / 255.0f;
-  look.shade = AMBIENT + DIFFUSE * static_cast<float>(
-                                       std::max(0.0, normal_world.dot(lightDirection())));
+  look.shade =
+      AMBIENT +
+      DIFFUSE * static_cast<float>(std::max(0.0, normal_world.dot(lightDirection())));
   return look;
 }
 
 /// An oriented box as seen from one camera pose.
 struct FrameBox {
-  Eigen::Matrix3f ray_to_box; ///< camera-frame ray direction to box frame
-  Eigen::Vector3f origin;     ///< camera centre in the box frame (metres)
-  Eigen::Vector3f half;       ///< half extents (metres)
-  std::uint8_t label;         ///< label written for its pixels (0 unless moving)
+  Eigen::Matrix3f ray_to_box;       ///< camera-frame ray direction to box frame
+  Eigen::Vector3f origin;           ///< camera centre in the box frame (metres)
+  Eigen::Vector3f half;             ///< half extents (metres)
+  std::uint8_t label;               ///< label written for its pixels (0 unless moving)
   std::array<SurfaceLook, 6> faces; ///< face 2a + s: axis a, s = 1 on the + side
-  int u0, u1, v0, v1;         ///< inclusive pixel rectangle holding its projection
+  int u0, u1, v0, v1; ///< inclusive pixel rectangle holding its projection
 };
 
 FrameBox
@@ -127,7 +129,8 @@ frameBox(const Eigen::Isometry3d& T_world_box,
 
 /// Depth model of SceneSynthesizer's class documentation, applied in place.
 void
-applyDepthModel(std::uint32_t seed, int k, int width, int height, std::vector<float>& depth)
+applyDepthModel(
+    std::uint32_t seed, int k, int width, int height, std::vector<float>& depth)
 {
   const std::vector<float> exact = depth;
   const float nan = std::numeric_limits<float>::quiet_NaN();
@@ -138,9 +141,12 @@ applyDepthModel(std::uint32_t seed, int k, int width, int height, std::vector<fl
     for (int u = 0; u < width; ++u) {
       const std::size_t i = static_cast<std::size_t>(v) * width + u;
       const float z = exact[i];
-      const auto nearer = [&](std::size_t n) { return z - exact[n] > jump * z; };
+      const auto nearer = [&](std::size_t n) {
+        return z - exact[n] > jump * z;
+      };
       const bool edge = (u > 0 && nearer(i - 1)) || (u + 1 < width && nearer(i + 1)) ||
-                        (v > 0 && nearer(i - width)) || (v + 1 < height && nearer(i + width));
+                        (v > 0 && nearer(i - width)) ||
+                        (v + 1 < height && nearer(i + width));
       const std::uint64_t r1 = detail::splitMix64(frame_key + i);
       const std::uint64_t r2 = detail::splitMix64(r1);
       const double dropout = static_cast<double>(r1 >> 40) / 16777216.0;
@@ -170,8 +176,9 @@ SynthOptions::validate() const
 {
   const std::string prefix = "[dynvo::SynthOptions::validate] ";
   const auto& all = detail::allScenarios();
-  if (std::none_of(all.begin(), all.end(),
-                   [this](const Scenario& s) { return s.name == scenario; }))
+  if (std::none_of(all.begin(), all.end(), [this](const Scenario& s) {
+        return s.name == scenario;
+      }))
     throw std::invalid_argument(prefix + "unknown scenario '" + scenario +
                                 "' (see SceneSynthesizer::scenarios())");
   if (frames < 1 || frames > 1000000)
@@ -187,7 +194,7 @@ SynthOptions::validate() const
 }
 
 SceneSynthesizer::SceneSynthesizer(const SynthOptions& options)
-: impl_(std::make_unique<Impl>())
+    : impl_(std::make_unique<Impl>())
 {
   options.validate();
   impl_->options = options;
@@ -268,9 +275,9 @@ SceneSynthesizer::render(int k) const
                              K, options));
   std::array<SurfaceLook, ROOM_SURFACES> room_faces;
   for (int face = 0; face < ROOM_SURFACES; ++face) // normals point into the room
-    room_faces[face] = surfaceLook(options.seed, face,
-                                   (face % 2 == 1 ? -1.0 : 1.0) *
-                                       Eigen::Vector3d::Unit(face / 2));
+    room_faces[face] =
+        surfaceLook(options.seed, face,
+                    (face % 2 == 1 ? -1.0 : 1.0) * Eigen::Vector3d::Unit(face / 2));
 
   const int width = options.width, height = options.height;
   const std::size_t pixels = static_cast<std::size_t>(width) * height;
@@ -289,7 +296,8 @@ SceneSynthesizer::render(int k) const
   const Eigen::Vector3f o = frame.T_world_camera.translation().cast<float>();
   const Eigen::Vector3f room_min = room.min_corner.cast<float>();
   const Eigen::Vector3f room_max = room.max_corner.cast<float>();
-  const float inv_fx = static_cast<float>(1.0 / K.fx), inv_fy = static_cast<float>(1.0 / K.fy);
+  const float inv_fx = static_cast<float>(1.0 / K.fx),
+              inv_fy = static_cast<float>(1.0 / K.fy);
   const float focal = static_cast<float>(std::min(K.fx, K.fy));
 
   for (int v = 0; v < height; ++v) {
@@ -310,7 +318,8 @@ SceneSynthesizer::render(int k) const
           axis = a;
         }
       }
-      const SurfaceLook* look = &room_faces[2 * axis + (ray_world[axis] > 0.0f ? 1 : 0)];
+      const SurfaceLook* look =
+          &room_faces[2 * axis + (ray_world[axis] > 0.0f ? 1 : 0)];
       Eigen::Vector3f hit = o + t_best * ray_world;
       float ray_along_normal = ray_world[axis];
       std::uint8_t label = 0;

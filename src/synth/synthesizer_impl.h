@@ -14,10 +14,10 @@ namespace dynvo {
 
 /// Scripted state of one frame (no rendering involved).
 struct FrameScript {
-  double timestamp;                  ///< colour stamp (s)
-  double depth_timestamp;            ///< depth stamp (s)
-  Eigen::Isometry3d T_world_camera;  ///< camera-to-world
-  std::vector<ObjectState> objects;  ///< every scripted object
+  double timestamp;                 ///< colour stamp (s)
+  double depth_timestamp;           ///< depth stamp (s)
+  Eigen::Isometry3d T_world_camera; ///< camera-to-world
+  std::vector<ObjectState> objects; ///< every scripted object
 };
 
 struct SceneSynthesizer::Impl {
@@ -26,8 +26,7 @@ struct SceneSynthesizer::Impl {
   CameraIntrinsics intrinsics; ///< scaled to the image size
 
   /// Poses, motion flags and stamps of frame k (0 <= k < frames).
-  FrameScript
-  script(int k) const;
+  FrameScript script(int k) const;
 };
 
 } // namespace dynvo

@@ -42,7 +42,8 @@ writePng(const fs::path& path, const cv::Mat& image)
 {
   bool written = false;
   try {
-    written = cv::imwrite(path.string(), image, {cv::IMWRITE_PNG_COMPRESSION, PNG_COMPRESSION});
+    written = cv::imwrite(path.string(), image,
+                          {cv::IMWRITE_PNG_COMPRESSION, PNG_COMPRESSION});
   }
   catch (const cv::Exception& e) {
     throw pcl::IOException(path.string() + ": cannot write PNG (" + e.what() + ")");
@@ -124,7 +125,8 @@ SceneSynthesizer::writeSequence(const std::string& folder, int threads) const
 {
   if (threads < 1)
     throw std::invalid_argument("[dynvo::SceneSynthesizer::writeSequence] threads must "
-                                "be >= 1, got " + std::to_string(threads));
+                                "be >= 1, got " +
+                                std::to_string(threads));
   const fs::path root(folder);
   prepareFolder(root);
   const int frames = impl_->options.frames;

@@ -49,7 +49,8 @@ setMatrix(vtkMatrix4x4* out, const Eigen::Matrix4d& m)
  * point (x, y, z) arrives as (x, -y, -z). Pixel u covers [u - 0.5, u + 0.5], hence the
  * half-pixel terms. Depth maps [near, far] onto [-1, 1]. */
 Eigen::Matrix4d
-pinholeProjection(const CameraIntrinsics& k, double width, double height, double near, double far)
+pinholeProjection(
+    const CameraIntrinsics& k, double width, double height, double near, double far)
 {
   Eigen::Matrix4d p = Eigen::Matrix4d::Zero();
   p(0, 0) = 2.0 * k.fx / width;
@@ -108,13 +109,14 @@ LabelRenderer::Parameters::validate() const
 
 /// The VTK pipeline: one window, a points actor and an overlay (trajectory + frustum) actor.
 struct LabelRenderer::Impl {
-  std::unique_ptr<detail::XConnection> x; ///< first member: outlives the window using it
+  std::unique_ptr<detail::XConnection>
+      x; ///< first member: outlives the window using it
   vtkNew<vtkRenderWindow> window;
   vtkNew<vtkRenderer> renderer;
-  vtkNew<vtkPoints> points;           ///< valid points, camera frame (metres)
-  vtkNew<vtkUnsignedCharArray> rgb;   ///< their blended colours
-  vtkNew<vtkIdTypeArray> offsets;     ///< {0, n}: one poly-vertex cell
-  vtkNew<vtkIdTypeArray> ids;         ///< 0 .. n-1
+  vtkNew<vtkPoints> points;         ///< valid points, camera frame (metres)
+  vtkNew<vtkUnsignedCharArray> rgb; ///< their blended colours
+  vtkNew<vtkIdTypeArray> offsets;   ///< {0, n}: one poly-vertex cell
+  vtkNew<vtkIdTypeArray> ids;       ///< 0 .. n-1
   vtkNew<vtkCellArray> vertices;
   vtkNew<vtkPolyData> cloud;
   vtkNew<vtkPolyDataMapper> cloud_mapper;
@@ -126,7 +128,8 @@ struct LabelRenderer::Impl {
   vtkNew<vtkMatrix4x4> projection; ///< pinhole projection of the camera view
   detail::WindowPngWriter png{window};
 
-  explicit Impl(std::unique_ptr<detail::XConnection> connection) : x(std::move(connection))
+  explicit Impl(std::unique_ptr<detail::XConnection> connection)
+      : x(std::move(connection))
   {
     window->SetDisplayId(x->get());
     window->SetOffScreenRendering(1);
@@ -152,16 +155,16 @@ struct LabelRenderer::Impl {
     overlay_mapper->ScalarVisibilityOff();
     overlay_actor->SetMapper(overlay_mapper);
     overlay_actor->GetProperty()->LightingOff();
-    overlay_actor->GetProperty()->SetColor(OVERLAY_RGB[0], OVERLAY_RGB[1], OVERLAY_RGB[2]);
+    overlay_actor->GetProperty()->SetColor(OVERLAY_RGB[0], OVERLAY_RGB[1],
+                                           OVERLAY_RGB[2]);
     overlay_actor->GetProperty()->SetLineWidth(2.0);
     renderer->AddActor(overlay_actor);
   }
 
   /// Valid points and colours into the VTK arrays; returns the camera-frame depth range.
-  std::pair<float, float>
-  setCloud(const pcl::PointCloud<pcl::PointXYZRGB>& cloud_in,
-           const std::vector<std::uint8_t>& labels,
-           double rgb_blend)
+  std::pair<float, float> setCloud(const pcl::PointCloud<pcl::PointXYZRGB>& cloud_in,
+                                   const std::vector<std::uint8_t>& labels,
+                                   double rgb_blend)
   {
     const vtkIdType capacity = static_cast<vtkIdType>(cloud_in.size());
     points->SetNumberOfPoints(capacity);
@@ -209,10 +212,9 @@ struct LabelRenderer::Impl {
   }
 
   /// Trajectory polyline and the current camera's frustum, in world coordinates.
-  void
-  setOverlay(const Trajectory& trajectory,
-             const Eigen::Isometry3d& pose,
-             const Parameters& params)
+  void setOverlay(const Trajectory& trajectory,
+                  const Eigen::Isometry3d& pose,
+                  const Parameters& params)
   {
     vtkNew<vtkPoints> overlay_points;
     vtkNew<vtkCellArray> lines;
@@ -224,17 +226,21 @@ struct LabelRenderer::Impl {
       }
     }
     const Eigen::Vector3d apex = pose.translation();
-    const vtkIdType apex_id = overlay_points->InsertNextPoint(apex.x(), apex.y(), apex.z());
+    const vtkIdType apex_id =
+        overlay_points->InsertNextPoint(apex.x(), apex.y(), apex.z());
     const float depth = static_cast<float>(params.frustum_depth);
     const float right = static_cast<float>(params.width) - 1.0f;
     const float bottom = static_cast<float>(params.height) - 1.0f;
-    const Eigen::Vector2f image_corners[4] = {{0.0f, 0.0f}, {right, 0.0f}, {right, bottom}, {0.0f, bottom}};
+    const Eigen::Vector2f image_corners[4] = {
+        {0.0f, 0.0f}, {right, 0.0f}, {right, bottom}, {0.0f, bottom}};
     vtkIdType corner_ids[4];
     for (int c = 0; c < 4; ++c) {
       const Eigen::Vector3d corner =
-          pose * params.intrinsics.backproject(image_corners[c].x(), image_corners[c].y(), depth)
+          pose * params.intrinsics
+                     .backproject(image_corners[c].x(), image_corners[c].y(), depth)
                      .cast<double>();
-      corner_ids[c] = overlay_points->InsertNextPoint(corner.x(), corner.y(), corner.z());
+      corner_ids[c] =
+          overlay_points->InsertNextPoint(corner.x(), corner.y(), corner.z());
     }
     for (int c = 0; c < 4; ++c) {
       const vtkIdType side[2] = {apex_id, corner_ids[c]};
@@ -247,10 +253,9 @@ struct LabelRenderer::Impl {
   }
 
   /// Pinhole camera at the pose, clipping just around the cloud's depth range.
-  void
-  setCameraView(const Eigen::Isometry3d& pose,
-                const Parameters& params,
-                std::pair<float, float> depth_range)
+  void setCameraView(const Eigen::Isometry3d& pose,
+                     const Parameters& params,
+                     std::pair<float, float> depth_range)
   {
     vtkCamera* camera = renderer->GetActiveCamera();
     const Eigen::Vector3d eye = pose.translation();
@@ -264,15 +269,14 @@ struct LabelRenderer::Impl {
     const bool any = depth_range.first <= depth_range.second;
     const double near = any ? std::max(0.99 * depth_range.first, 1e-3) : 0.1;
     const double far = any ? std::max(1.01 * depth_range.second, 2.0 * near) : 10.0;
-    setMatrix(projection,
-              pinholeProjection(params.intrinsics, params.width, params.height, near, far));
+    setMatrix(projection, pinholeProjection(params.intrinsics, params.width,
+                                            params.height, near, far));
     camera->SetExplicitProjectionTransformMatrix(projection);
     camera->UseExplicitProjectionTransformMatrixOn();
   }
 
   /// Perspective camera looking along -`towards_eye` (world) at everything drawn.
-  void
-  setSceneView(const Eigen::Vector3d& towards_eye, const Eigen::Vector3d& up)
+  void setSceneView(const Eigen::Vector3d& towards_eye, const Eigen::Vector3d& up)
   {
     vtkCamera* camera = renderer->GetActiveCamera();
     camera->UseExplicitProjectionTransformMatrixOff();
@@ -294,8 +298,7 @@ LabelRenderer::LabelRenderer(const Parameters& params)
 
 LabelRenderer::~LabelRenderer() = default;
 LabelRenderer::LabelRenderer(LabelRenderer&&) noexcept = default;
-LabelRenderer&
-LabelRenderer::operator=(LabelRenderer&&) noexcept = default;
+LabelRenderer& LabelRenderer::operator=(LabelRenderer&&) noexcept = default;
 
 void
 LabelRenderer::setParameters(const Parameters& params)
@@ -351,16 +354,18 @@ LabelRenderer::render(const pcl::PointCloud<pcl::PointXYZRGB>& cloud,
     auto connection = std::make_unique<detail::XConnection>();
     if (!connection->get()) {
       no_display_ = true;
-      PCL_WARN("%s no display (%s): no images are written; run under `xvfb-run -a` on a "
-               "headless machine\n",
-               prefix, connection->reason().c_str());
+      PCL_WARN(
+          "%s no display (%s): no images are written; run under `xvfb-run -a` on a "
+          "headless machine\n",
+          prefix, connection->reason().c_str());
       return false;
     }
     impl_ = std::make_unique<Impl>(std::move(connection));
   }
 
   Impl& vtk = *impl_;
-  vtk.window->SetSize(static_cast<int>(params_.width), static_cast<int>(params_.height));
+  vtk.window->SetSize(static_cast<int>(params_.width),
+                      static_cast<int>(params_.height));
   const auto depth_range = vtk.setCloud(cloud, labels, params_.rgb_blend);
   // In the camera view every point sits on its own pixel centre, so one pixel per point
   // fills the image exactly and keeps neighbouring labels from bleeding into each other.

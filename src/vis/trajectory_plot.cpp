@@ -127,9 +127,9 @@ TrajectoryPlotOptions::validate() const
         "(room for axes and labels), got " +
         std::to_string(width) + "x" + std::to_string(height));
   if (!(max_time_difference > 0.0 && std::isfinite(max_time_difference)))
-    throw std::invalid_argument(
-        "[dynvo::TrajectoryPlotOptions::validate] max_time_difference must be > 0 s, got " +
-        std::to_string(max_time_difference));
+    throw std::invalid_argument("[dynvo::TrajectoryPlotOptions::validate] "
+                                "max_time_difference must be > 0 s, got " +
+                                std::to_string(max_time_difference));
 }
 
 bool
@@ -160,8 +160,8 @@ writeTrajectoryPlot(const Trajectory& estimate,
       estimate_stamps.push_back(p.timestamp);
     for (const StampedPose& p : groundtruth)
       groundtruth_stamps.push_back(p.timestamp);
-    for (const auto& [e, g] : associateTimestamps(
-             estimate_stamps, groundtruth_stamps, options.max_time_difference)) {
+    for (const auto& [e, g] : associateTimestamps(estimate_stamps, groundtruth_stamps,
+                                                  options.max_time_difference)) {
       error_time.push_back(estimate[e].timestamp - estimate.front().timestamp);
       error.push_back((estimate[e].T_world_camera.translation() -
                        groundtruth[g].T_world_camera.translation())
@@ -201,7 +201,8 @@ writeTrajectoryPlot(const Trajectory& estimate,
   if (!groundtruth.empty())
     addCurve(path, gt_xs, gt_ys, "x (m)", vertical_name, "ground truth",
              options.groundtruth_color);
-  addCurve(path, est_xs, est_ys, "x (m)", vertical_name, "estimate", options.estimate_color);
+  addCurve(path, est_xs, est_ys, "x (m)", vertical_name, "estimate",
+           options.estimate_color);
   fitAxes(path, {&gt_xs, &est_xs}, {&gt_ys, &est_ys}, "x (m)", vertical_name);
 
   if (!error.empty()) {

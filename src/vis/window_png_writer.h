@@ -23,8 +23,7 @@ public:
    * \param[in] caller "[dynvo::Class::method]" prefix for the error message
    * \return false (with a PCL_ERROR) when the file cannot be written
    */
-  bool
-  write(const std::string& path, const char* caller);
+  bool write(const std::string& path, const char* caller);
 
 private:
   vtkNew<vtkWindowToImageFilter> grab_; ///< window pixels, RGB, no re-render

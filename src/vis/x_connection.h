@@ -19,21 +19,12 @@ public:
   XConnection();
   ~XConnection();
   XConnection(const XConnection&) = delete;
-  XConnection&
-  operator=(const XConnection&) = delete;
+  XConnection& operator=(const XConnection&) = delete;
 
   /// The Display*, or null when none could be opened.
-  void*
-  get() const
-  {
-    return display_;
-  }
+  void* get() const { return display_; }
 
-  const std::string&
-  reason() const
-  {
-    return reason_;
-  }
+  const std::string& reason() const { return reason_; }
 
 private:
   void* display_ = nullptr; ///< Display*, kept opaque so Xlib's macros stay in one file

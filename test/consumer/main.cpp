@@ -16,6 +16,7 @@ main()
   grid[0].getVector3fMap() = camera.backproject(318.6f, 255.3f, 2.0f);
   dynvo::GridSceneFlowEstimation<pcl::PointXYZRGB> flow_estimation;
   flow_estimation.setCameraIntrinsics(camera);
-  std::printf("consumer ok fx=%.1f cells=%zu z=%.1f\n", camera.fx, grid.size(), grid[0].z);
+  std::printf("consumer ok fx=%.1f cells=%zu z=%.1f\n", camera.fx, grid.size(),
+              grid[0].z);
   return grid[0].z == 2.0f ? 0 : 1;
 }

@@ -13,7 +13,6 @@ struct CommandResult {
 };
 
 /// Runs `command` through /bin/sh, capturing stdout and stderr separately.
-CommandResult
-runCommand(const std::string& command);
+CommandResult runCommand(const std::string& command);
 
 } // namespace dynvo::test

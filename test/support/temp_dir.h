@@ -13,32 +13,21 @@ public:
   TempDir();
   ~TempDir();
   TempDir(const TempDir&) = delete;
-  TempDir&
-  operator=(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
 
-  const std::filesystem::path&
-  path() const
-  {
-    return path_;
-  }
+  const std::filesystem::path& path() const { return path_; }
 
   /// path() / name as a string.
-  std::string
-  file(const std::string& name) const
-  {
-    return (path_ / name).string();
-  }
+  std::string file(const std::string& name) const { return (path_ / name).string(); }
 
 private:
   std::filesystem::path path_;
 };
 
 /// Writes text to a file, replacing it.
-void
-writeText(const std::string& path, const std::string& text);
+void writeText(const std::string& path, const std::string& text);
 
 /// The whole content of a file ("" when it cannot be read).
-std::string
-readText(const std::string& path);
+std::string readText(const std::string& path);
 
 } // namespace dynvo::test

@@ -160,7 +160,9 @@ check(XnStatus status, const char* what)
 
 /// Parent process: write `frames` synthetic frames to `out` with OpenNI 1 mock nodes.
 bool
-writeFixture(const std::string& seed, const std::string& out, int frames,
+writeFixture(const std::string& seed,
+             const std::string& out,
+             int frames,
              std::uint64_t period_us)
 {
   xn::Context context;

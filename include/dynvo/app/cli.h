@@ -43,38 +43,25 @@ public:
             std::size_t positional = 0);
 
   /// True when "-h" or "--help" was given (positional count is then not checked).
-  bool
-  helpRequested() const
-  {
-    return help_;
-  }
+  bool helpRequested() const { return help_; }
 
   /// True when the flag or switch was given.
-  bool
-  has(const std::string& name) const;
+  bool has(const std::string& name) const;
 
   /// The flag's value, or fallback when absent.
-  std::string
-  string(const std::string& name, const std::string& fallback = "") const;
+  std::string string(const std::string& name, const std::string& fallback = "") const;
 
   /// The flag's value as a finite number. \throws UsageError when it does not parse
-  double
-  number(const std::string& name, double fallback) const;
+  double number(const std::string& name, double fallback) const;
 
   /// The flag's value as an integer. \throws UsageError when it does not parse
-  long
-  integer(const std::string& name, long fallback) const;
+  long integer(const std::string& name, long fallback) const;
 
   /// Positional arguments in order.
-  const std::vector<std::string>&
-  positional() const
-  {
-    return positional_;
-  }
+  const std::vector<std::string>& positional() const { return positional_; }
 
   /// One line per option: "-name VALUE  help".
-  std::string
-  optionsHelp() const;
+  std::string optionsHelp() const;
 
 private:
   std::vector<Option> options_;
@@ -84,15 +71,13 @@ private:
 };
 
 /// The message of an exception without PCLException's ": " prefix.
-DYNVO_EXPORTS std::string
-errorMessage(const std::exception& e);
+DYNVO_EXPORTS std::string errorMessage(const std::exception& e);
 
 /** \brief Runs an app's body with the house exit-code policy.
  * UsageError: message and usage on stderr, exit 2. Other std::exception: message via
  * pcl::console::print_error, exit 1. Otherwise the body's return value (0 or 1).
  * \param[in] usage printed after a usage error, e.g. "dynvo_evaluate GT EST [options]"
  */
-DYNVO_EXPORTS int
-runApp(const std::string& usage, const std::function<int()>& body);
+DYNVO_EXPORTS int runApp(const std::string& usage, const std::function<int()>& body);
 
 } // namespace dynvo::app

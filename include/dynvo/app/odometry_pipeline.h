@@ -28,20 +28,21 @@ struct DYNVO_EXPORTS PipelineOptions {
   /// 3e-5 (TUM fr1/xyz: RPE 0.053 m/s and 5 lost frames at 3e-5, 0.036 m/s and 1 at 6e-5).
   PipelineOptions();
 
-  CameraIntrinsics intrinsics;                    ///< back-projection of the input frames
-  GridSceneFlowParameters scene_flow;             ///< ALGORITHM.md §1
-  RigidMotionSegmentationParameters segmentation; ///< ALGORITHM.md §3-§6 (seed included)
+  CameraIntrinsics intrinsics;        ///< back-projection of the input frames
+  GridSceneFlowParameters scene_flow; ///< ALGORITHM.md §1
+  RigidMotionSegmentationParameters
+      segmentation; ///< ALGORITHM.md §3-§6 (seed included)
   StaticSceneRegistrationParameters registration; ///< ALGORITHM.md §7
-  bool use_segmentation = true; ///< false: ablation, every valid flow cell counts as static
+  bool use_segmentation =
+      true; ///< false: ablation, every valid flow cell counts as static
   /// Static support (multiple of registration.th_inlier, 0 = off): after a first fit on the
   /// background segment, every valid cell whose flow agrees with it within this many
   /// th_inlier (4: 11 mm) joins the static set for the final fit.
   float static_consensus = 4.0f;
-  unsigned threads = 1;         ///< worker threads; results do not depend on it
+  unsigned threads = 1; ///< worker threads; results do not depend on it
 
   /// \throws std::invalid_argument when a module's parameters or a pipeline value are invalid
-  void
-  validate() const;
+  void validate() const;
 };
 
 /// Wall-clock time of each stage of one frame (milliseconds), image decoding excluded.
@@ -55,18 +56,22 @@ struct StageTimes {
 /// Everything the pipeline knows about one frame.
 struct FrameResult {
   double timestamp = 0.0; ///< seconds
-  Eigen::Matrix4d T_world_curr = Eigen::Matrix4d::Identity(); ///< camera pose (camera-to-world)
-  Eigen::Matrix4d T_curr_prev = Eigen::Matrix4d::Identity();  ///< ego-motion H_k (identity at frame 0)
-  bool lost = false; ///< too few static cells: T_curr_prev is the constant-velocity prediction
+  Eigen::Matrix4d T_world_curr =
+      Eigen::Matrix4d::Identity(); ///< camera pose (camera-to-world)
+  Eigen::Matrix4d T_curr_prev =
+      Eigen::Matrix4d::Identity(); ///< ego-motion H_k (identity at frame 0)
+  bool lost =
+      false; ///< too few static cells: T_curr_prev is the constant-velocity prediction
   /// segments[0] = static background pixels, then moving objects (pcl::PointIndices each)
   std::vector<pcl::PointIndices> segments;
   std::vector<std::uint8_t> segment_labels; ///< label id of each segment (1 = static)
   /// T_curr_prev of each segment (metres): objects' frame-to-frame motion in the current frame
   std::vector<Eigen::Matrix4f, Eigen::aligned_allocator<Eigen::Matrix4f>> motions;
-  std::uint32_t width = 0;          ///< image columns (px)
-  std::uint32_t height = 0;         ///< image rows (px)
-  std::vector<std::uint8_t> labels; ///< per pixel: 0 no measurement, 1 static, 2.. objects
-  StageTimes times;                 ///< stage timings
+  std::uint32_t width = 0;  ///< image columns (px)
+  std::uint32_t height = 0; ///< image rows (px)
+  std::vector<std::uint8_t>
+      labels;       ///< per pixel: 0 no measurement, 1 static, 2.. objects
+  StageTimes times; ///< stage timings
 };
 
 /** \brief Chains GridSceneFlowEstimation, RigidMotionSegmentation and StaticSceneRegistration
@@ -89,8 +94,7 @@ public:
   explicit OdometryPipeline(const PipelineOptions& options);
   ~OdometryPipeline();
   OdometryPipeline(const OdometryPipeline&) = delete;
-  OdometryPipeline&
-  operator=(const OdometryPipeline&) = delete;
+  OdometryPipeline& operator=(const OdometryPipeline&) = delete;
 
   /** \brief Processes the next frame of the sequence.
    * \param[in] cloud organized frame (metres, NaN where no depth), same size every frame
@@ -98,16 +102,14 @@ public:
    * \return the frame's result, valid until the next call
    * \throws std::invalid_argument when the cloud is null, unorganized or changes size
    */
-  const FrameResult&
-  process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& cloud, double timestamp);
+  const FrameResult& process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& cloud,
+                             double timestamp);
 
   /// Forgets the sequence: the next frame becomes frame 0 again.
-  void
-  reset();
+  void reset();
 
   /// Frames processed since construction or reset().
-  std::size_t
-  frameCount() const;
+  std::size_t frameCount() const;
 
 private:
   struct Impl;

@@ -17,12 +17,12 @@ namespace dynvo::app {
  * \throws pcl::IOException naming the file and the key when the file cannot be read, a key is
  *         unknown, a value has the wrong type, or the options are invalid
  */
-DYNVO_EXPORTS void
-loadPipelineConfig(const std::string& path, PipelineOptions& options);
+DYNVO_EXPORTS void loadPipelineConfig(const std::string& path,
+                                      PipelineOptions& options);
 
 /// Writes options as a YAML file that loadPipelineConfig() reads back unchanged.
 /// \throws pcl::IOException when the file cannot be written
-DYNVO_EXPORTS void
-writePipelineConfig(const std::string& path, const PipelineOptions& options);
+DYNVO_EXPORTS void writePipelineConfig(const std::string& path,
+                                       const PipelineOptions& options);
 
 } // namespace dynvo::app

@@ -30,19 +30,13 @@ public:
              const Trajectory* initial_groundtruth = nullptr);
 
   /// Records one frame. \throws pcl::IOException when a file cannot be written
-  void
-  add(const FrameResult& result);
+  void add(const FrameResult& result);
 
   /// Writes the trajectory and moves the objects file into place.
-  void
-  finish();
+  void finish();
 
   /// Camera poses so far (camera-to-world).
-  const Trajectory&
-  trajectory() const
-  {
-    return trajectory_;
-  }
+  const Trajectory& trajectory() const { return trajectory_; }
 
 private:
   std::string trajectory_path_;
@@ -61,24 +55,18 @@ public:
   explicit RunReport(std::size_t expected_frames);
 
   /// Records one frame (frame 0 only prepares the pipeline and is not timed).
-  void
-  add(const FrameResult& result);
+  void add(const FrameResult& result);
 
   /// Frames recorded.
-  std::size_t
-  frames() const
-  {
-    return frames_;
-  }
+  std::size_t frames() const { return frames_; }
 
   /// Prints the per-stage medians, then `accuracy` when not empty, and last
   /// "frames=<n> lost=<n> median_ms=<x> mean_ms=<x> fps=<x>" (per frame, decoding excluded).
-  void
-  printSummary(const std::string& accuracy = "") const;
+  void printSummary(const std::string& accuracy = "") const;
 
   /// The dynvo_evaluate line of the estimate against the ground truth (or why there is none).
-  static std::string
-  accuracy(const Trajectory& groundtruth, const Trajectory& estimate);
+  static std::string accuracy(const Trajectory& groundtruth,
+                              const Trajectory& estimate);
 
 private:
   std::size_t expected_frames_;

@@ -27,29 +27,23 @@ struct DYNVO_EXPORTS CameraIntrinsics {
    *            "fr1", "fr2", "fr3" (TUM RGB-D calibrations), "icsl" (ICSL-DE Xtion)
    * \throws std::invalid_argument for an unknown name
    */
-  static CameraIntrinsics
-  fromPreset(const std::string& name);
+  static CameraIntrinsics fromPreset(const std::string& name);
 
   /// Names accepted by fromPreset(), in a fixed order.
-  static std::vector<std::string>
-  presetNames();
+  static std::vector<std::string> presetNames();
 
   /// Throws std::invalid_argument unless fx, fy > 0 and all values are finite.
-  void
-  validate() const;
+  void validate() const;
 
   /// 3D point (metres) seen at pixel (u, v) with depth z (metres).
-  Eigen::Vector3f
-  backproject(float u, float v, float z) const
+  Eigen::Vector3f backproject(float u, float v, float z) const
   {
     return {static_cast<float>((u - cx) * z / fx),
-            static_cast<float>((v - cy) * z / fy),
-            z};
+            static_cast<float>((v - cy) * z / fy), z};
   }
 
   /// Pixel (u, v) where point p (metres, z > 0) projects.
-  Eigen::Vector2f
-  project(const Eigen::Vector3f& p) const
+  Eigen::Vector2f project(const Eigen::Vector3f& p) const
   {
     return {static_cast<float>(fx * p.x() / p.z() + cx),
             static_cast<float>(fy * p.y() / p.z() + cy)};

@@ -17,15 +17,15 @@ namespace dynvo {
  * Invalid cells hold NaN coordinates and weight 0.
  */
 struct EIGEN_ALIGN16 PointFlow {
-  PCL_ADD_POINT4D;      ///< current point b_i (metres, current camera frame)
-  float prev_x;         ///< previous point a_i, x (metres, previous camera frame)
-  float prev_y;         ///< previous point a_i, y (metres)
-  float prev_z;         ///< previous point a_i, z (metres)
-  float u;              ///< cell centre column in the current image (px)
-  float v;              ///< cell centre row in the current image (px)
-  float prev_u;         ///< tracked column in the previous image (px)
-  float prev_v;         ///< tracked row in the previous image (px)
-  float weight;         ///< confidence in [0, 1]; 0 for invalid cells
+  PCL_ADD_POINT4D;       ///< current point b_i (metres, current camera frame)
+  float prev_x;          ///< previous point a_i, x (metres, previous camera frame)
+  float prev_y;          ///< previous point a_i, y (metres)
+  float prev_z;          ///< previous point a_i, z (metres)
+  float u;               ///< cell centre column in the current image (px)
+  float v;               ///< cell centre row in the current image (px)
+  float prev_u;          ///< tracked column in the previous image (px)
+  float prev_v;          ///< tracked row in the previous image (px)
+  float weight;          ///< confidence in [0, 1]; 0 for invalid cells
   std::uint8_t valid_2d; ///< 1 when the 2D track passed all checks
   std::uint8_t valid_3d; ///< 1 when both 3D points exist and passed the checks
   PCL_MAKE_ALIGNED_OPERATOR_NEW

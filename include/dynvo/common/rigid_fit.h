@@ -14,7 +14,7 @@ namespace dynvo {
 enum class RigidFitStatus {
   ok,             ///< a unique rigid transformation was found
   too_few_points, ///< fewer than 3 pairs with a positive weight
-  degenerate      ///< the pairs are (nearly) collinear: s2 < 1e-9 s1, or all at one point
+  degenerate ///< the pairs are (nearly) collinear: s2 < 1e-9 s1, or all at one point
 };
 
 /** \brief Weighted least-squares rigid fit without scale (Kabsch/Umeyama, Eggert et al. 1997).
@@ -44,36 +44,36 @@ public:
    * \param[in] weight w_i >= 0; a pair of weight 0 is ignored
    * \throws std::invalid_argument when a coordinate or the weight is not finite, or weight < 0
    */
-  void
-  add(const Eigen::Vector3d& source, const Eigen::Vector3d& target, double weight = 1.0);
+  void add(const Eigen::Vector3d& source,
+           const Eigen::Vector3d& target,
+           double weight = 1.0);
 
   /// Forgets every pair.
-  void
-  clear();
+  void clear();
 
   /// Number of pairs added with a positive weight.
-  std::size_t
-  size() const
-  {
-    return count_;
-  }
+  std::size_t size() const { return count_; }
 
   /** \brief Solves for the rigid transformation.
    * \param[out] T_target_source maps source points into the target frame; written only when
    *             the result is RigidFitStatus::ok, so a caller can keep a previous fit
    * \return ok, too_few_points (fewer than 3 pairs) or degenerate (see RigidFitStatus)
    */
-  RigidFitStatus
-  solve(Eigen::Matrix4d& T_target_source) const;
+  RigidFitStatus solve(Eigen::Matrix4d& T_target_source) const;
 
 private:
-  std::size_t count_ = 0;                                     ///< pairs with weight > 0
-  double weight_sum_ = 0.0;                                   ///< sum w_i
-  Eigen::Vector3d source_origin_ = Eigen::Vector3d::Zero();  ///< s of the first pair (metres)
-  Eigen::Vector3d target_origin_ = Eigen::Vector3d::Zero();  ///< q of the first pair (metres)
-  Eigen::Vector3d source_sum_ = Eigen::Vector3d::Zero();     ///< sum w_i (s_i - source_origin_)
-  Eigen::Vector3d target_sum_ = Eigen::Vector3d::Zero();     ///< sum w_i (q_i - target_origin_)
-  Eigen::Matrix3d cross_sum_ = Eigen::Matrix3d::Zero();      ///< sum w_i (q_i - q0)(s_i - s0)^T
+  std::size_t count_ = 0;   ///< pairs with weight > 0
+  double weight_sum_ = 0.0; ///< sum w_i
+  Eigen::Vector3d source_origin_ =
+      Eigen::Vector3d::Zero(); ///< s of the first pair (metres)
+  Eigen::Vector3d target_origin_ =
+      Eigen::Vector3d::Zero(); ///< q of the first pair (metres)
+  Eigen::Vector3d source_sum_ =
+      Eigen::Vector3d::Zero(); ///< sum w_i (s_i - source_origin_)
+  Eigen::Vector3d target_sum_ =
+      Eigen::Vector3d::Zero(); ///< sum w_i (q_i - target_origin_)
+  Eigen::Matrix3d cross_sum_ =
+      Eigen::Matrix3d::Zero(); ///< sum w_i (q_i - q0)(s_i - s0)^T
 };
 
 /** \brief Squared transfer error E_i = || R s + t - q ||^2 (m^2) of one pair under

@@ -31,7 +31,6 @@ associateTimestamps(const std::vector<double>& first,
  * \param[in] sorted non-empty list sorted in increasing order
  * \param[in] t query value
  */
-DYNVO_EXPORTS std::size_t
-findClosestIndex(const std::vector<double>& sorted, double t);
+DYNVO_EXPORTS std::size_t findClosestIndex(const std::vector<double>& sorted, double t);
 
 } // namespace dynvo

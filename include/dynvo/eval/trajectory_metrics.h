@@ -41,16 +41,16 @@ struct RpeResult {
  * \throws std::invalid_argument when a trajectory has fewer than 2 poses, delta is not
  *         positive, or no pair can be formed
  */
-DYNVO_EXPORTS RpeResult
-computeRpe(const Trajectory& groundtruth,
-           const Trajectory& estimate,
-           const RpeOptions& options = {});
+DYNVO_EXPORTS RpeResult computeRpe(const Trajectory& groundtruth,
+                                   const Trajectory& estimate,
+                                   const RpeOptions& options = {});
 
 /// Absolute trajectory error after rigid alignment.
 struct AteResult {
   double rmse = 0.0;     ///< RMSE of the aligned position differences (metres)
   std::size_t pairs = 0; ///< associated pose pairs
-  Eigen::Isometry3d T_groundtruth_estimate = Eigen::Isometry3d::Identity(); ///< alignment
+  Eigen::Isometry3d T_groundtruth_estimate =
+      Eigen::Isometry3d::Identity(); ///< alignment
 };
 
 /** \brief Absolute trajectory error as evaluate_ate.py: stamps associated one-to-one
@@ -58,16 +58,15 @@ struct AteResult {
  * no scale) of the estimated positions onto the ground truth, RMSE of the residuals.
  * \throws std::invalid_argument when fewer than 3 stamps associate
  */
-DYNVO_EXPORTS AteResult
-computeAte(const Trajectory& groundtruth,
-           const Trajectory& estimate,
-           double max_difference = 0.02);
+DYNVO_EXPORTS AteResult computeAte(const Trajectory& groundtruth,
+                                   const Trajectory& estimate,
+                                   double max_difference = 0.02);
 
 /** \brief The estimate moved into the ground truth's world frame by the ATE alignment
  * (for plotting both together); unchanged when fewer than 3 stamps associate.
  */
-DYNVO_EXPORTS Trajectory
-alignToGroundTruth(const Trajectory& groundtruth, const Trajectory& estimate);
+DYNVO_EXPORTS Trajectory alignToGroundTruth(const Trajectory& groundtruth,
+                                            const Trajectory& estimate);
 
 /** \brief The result line of dynvo_evaluate:
  * "rpe_trans_rmse=<m/s> rpe_trans_mean=<m/s> rpe_rot_rmse=<deg/s> ate_rmse=<m> pairs=<n>",

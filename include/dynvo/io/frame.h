@@ -23,16 +23,17 @@ struct ColorImage {
 
 /// Depth image in metres, row-major; NaN marks a missing measurement.
 struct DepthImage {
-  std::uint32_t width = 0; ///< columns (px)
+  std::uint32_t width = 0;  ///< columns (px)
   std::uint32_t height = 0; ///< rows (px)
-  std::vector<float> data; ///< width * height depths (metres)
+  std::vector<float> data;  ///< width * height depths (metres)
 };
 
 /** \brief One RGB-D frame as delivered by a FrameSource. */
 struct Frame {
   double timestamp = 0.0; ///< seconds; the colour image's stamp
   std::string name;       ///< where the frame came from (file name), for messages
-  pcl::PointCloud<pcl::PointXYZRGB>::Ptr cloud; ///< organized, current camera frame (metres), NaN where no depth
+  pcl::PointCloud<pcl::PointXYZRGB>::Ptr
+      cloud;        ///< organized, current camera frame (metres), NaN where no depth
   ColorImage color; ///< the colour image the cloud was made from
   DepthImage depth; ///< the depth image the cloud was made from (metres)
 };

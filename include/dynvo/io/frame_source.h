@@ -31,12 +31,10 @@ public:
    * \param[out] frame the frame; untouched when the sequence has ended
    * \return false at the end of the sequence
    */
-  virtual bool
-  next(Frame& frame) = 0;
+  virtual bool next(Frame& frame) = 0;
 
   /// Number of frames in the whole sequence, or 0 when the source cannot tell.
-  virtual std::size_t
-  size() const = 0;
+  virtual std::size_t size() const = 0;
 };
 
 } // namespace dynvo

@@ -16,39 +16,34 @@ namespace dynvo {
 
 /// Per-pixel labels of one frame: 0 no measurement, 1 static background, 2.. moving objects.
 struct LabelImage {
-  std::uint32_t width = 0;          ///< columns (px)
-  std::uint32_t height = 0;         ///< rows (px)
-  std::vector<std::uint8_t> data;   ///< width * height labels, row-major
+  std::uint32_t width = 0;        ///< columns (px)
+  std::uint32_t height = 0;       ///< rows (px)
+  std::vector<std::uint8_t> data; ///< width * height labels, row-major
 };
 
 /** \brief Label image of a segmentation: the pixels of segments[s] get labels[s], every
  * other pixel 0 (no measurement). Indices are linear pixel indices (row * width + col).
  */
-DYNVO_EXPORTS LabelImage
-paintLabelImage(const std::vector<pcl::PointIndices>& segments,
-                const std::vector<std::uint8_t>& labels,
-                std::uint32_t width,
-                std::uint32_t height);
+DYNVO_EXPORTS LabelImage paintLabelImage(const std::vector<pcl::PointIndices>& segments,
+                                         const std::vector<std::uint8_t>& labels,
+                                         std::uint32_t width,
+                                         std::uint32_t height);
 
 /// File name of a frame's label image: "<timestamp %.6f>.png".
-DYNVO_EXPORTS std::string
-labelFileName(double timestamp);
+DYNVO_EXPORTS std::string labelFileName(double timestamp);
 
 /// Writes an 8-bit single-channel PNG. \throws pcl::IOException naming the file on failure
-DYNVO_EXPORTS void
-writeLabelImage(const std::string& path, const LabelImage& labels);
+DYNVO_EXPORTS void writeLabelImage(const std::string& path, const LabelImage& labels);
 
 /// Reads an 8-bit single-channel PNG. \throws pcl::IOException naming the file and problem
-DYNVO_EXPORTS LabelImage
-readLabelImage(const std::string& path);
+DYNVO_EXPORTS LabelImage readLabelImage(const std::string& path);
 
 /** \brief One line of an objects file: "timestamp id n_pixels tx ty tz qx qy qz qw", where the
  * pose is the object's frame-to-frame motion T_curr_prev (metres) in the current camera frame.
  */
-DYNVO_EXPORTS std::string
-formatObjectMotionLine(double timestamp,
-                       int id,
-                       std::size_t pixels,
-                       const Eigen::Matrix4f& T_curr_prev);
+DYNVO_EXPORTS std::string formatObjectMotionLine(double timestamp,
+                                                 int id,
+                                                 std::size_t pixels,
+                                                 const Eigen::Matrix4f& T_curr_prev);
 
 } // namespace dynvo

@@ -44,11 +44,9 @@ public:
   explicit OniFileSource(const std::string& file);
   ~OniFileSource() override;
 
-  bool
-  next(Frame& frame) override;
+  bool next(Frame& frame) override;
 
-  std::size_t
-  size() const override;
+  std::size_t size() const override;
 
 private:
   struct Impl;

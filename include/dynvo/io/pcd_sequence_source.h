@@ -23,21 +23,12 @@ public:
   /// \throws std::invalid_argument when fps is not positive
   explicit PcdSequenceSource(const std::string& folder, double fps = 30.0);
 
-  bool
-  next(Frame& frame) override;
+  bool next(Frame& frame) override;
 
-  std::size_t
-  size() const override
-  {
-    return files_.size();
-  }
+  std::size_t size() const override { return files_.size(); }
 
   /// The files in the order they are delivered.
-  const std::vector<std::string>&
-  files() const
-  {
-    return files_;
-  }
+  const std::vector<std::string>& files() const { return files_; }
 
 private:
   std::vector<std::string> files_;
@@ -46,7 +37,6 @@ private:
 };
 
 /// True when a's name sorts before b's in natural order (digit runs compared as numbers).
-DYNVO_EXPORTS bool
-naturalLess(const std::string& a, const std::string& b);
+DYNVO_EXPORTS bool naturalLess(const std::string& a, const std::string& b);
 
 } // namespace dynvo

@@ -13,7 +13,7 @@ namespace dynvo {
 
 /// A camera pose at a time: T_world_camera maps camera coordinates to world (metres).
 struct StampedPose {
-  double timestamp = 0.0;                                     ///< seconds
+  double timestamp = 0.0;                                           ///< seconds
   Eigen::Isometry3d T_world_camera = Eigen::Isometry3d::Identity(); ///< camera-to-world
 };
 
@@ -27,18 +27,16 @@ using Trajectory = std::vector<StampedPose>;
  * \throws pcl::IOException "<file>:<line>: <problem>" on any violation or when the file
  *         cannot be opened
  */
-DYNVO_EXPORTS Trajectory
-readTrajectory(const std::string& path);
+DYNVO_EXPORTS Trajectory readTrajectory(const std::string& path);
 
 /** \brief Write a TUM trajectory file (timestamps "%.6f", qw >= 0).
  * The file is written beside its destination and renamed into place, so a failure never
  * leaves a truncated file. \throws pcl::IOException when it cannot be written
  */
-DYNVO_EXPORTS void
-writeTrajectory(const std::string& path, const Trajectory& trajectory);
+DYNVO_EXPORTS void writeTrajectory(const std::string& path,
+                                   const Trajectory& trajectory);
 
 /// One TUM line for a pose, without the newline.
-DYNVO_EXPORTS std::string
-formatTumLine(const StampedPose& pose);
+DYNVO_EXPORTS std::string formatTumLine(const StampedPose& pose);
 
 } // namespace dynvo

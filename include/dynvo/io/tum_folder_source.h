@@ -21,8 +21,9 @@ namespace dynvo {
 class DYNVO_EXPORTS TumFolderSource : public FrameSource {
 public:
   struct Options {
-    CameraIntrinsics intrinsics;  ///< default preset (525, 525, 319.5, 239.5)
-    double depth_scale = 0.0;     ///< raw units per metre; 0 = 5000 (TUM) or 1000 (associations.txt)
+    CameraIntrinsics intrinsics; ///< default preset (525, 525, 319.5, 239.5)
+    double depth_scale =
+        0.0; ///< raw units per metre; 0 = 5000 (TUM) or 1000 (associations.txt)
     double max_difference = 0.02; ///< association tolerance (seconds)
   };
 
@@ -37,32 +38,18 @@ public:
   /// \throws pcl::IOException when the folder or its index files are missing or corrupt
   explicit TumFolderSource(const std::string& folder, const Options& options);
 
-  bool
-  next(Frame& frame) override;
+  bool next(Frame& frame) override;
 
-  std::size_t
-  size() const override
-  {
-    return entries_.size();
-  }
+  std::size_t size() const override { return entries_.size(); }
 
   /// The associated pairs, in time order.
-  const std::vector<Entry>&
-  entries() const
-  {
-    return entries_;
-  }
+  const std::vector<Entry>& entries() const { return entries_; }
 
   /// Depth scale in use (raw units per metre).
-  double
-  depthScale() const
-  {
-    return depth_scale_;
-  }
+  double depthScale() const { return depth_scale_; }
 
   /// Read pair i (0-based) without moving the cursor. \throws pcl::IOException
-  Frame
-  read(std::size_t i) const;
+  Frame read(std::size_t i) const;
 
 private:
   std::string folder_;

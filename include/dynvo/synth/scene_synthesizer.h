@@ -23,9 +23,11 @@ struct ScenarioInfo {
 
 /// Pose and state of one scripted object at one frame.
 struct ObjectState {
-  int id = 0;                                                   ///< 1, 2, ... (label value)
-  Eigen::Isometry3d T_world_object = Eigen::Isometry3d::Identity(); ///< object-to-world (metres)
-  bool moving = false; ///< true when the object moves between the previous frame and this one
+  int id = 0; ///< 1, 2, ... (label value)
+  Eigen::Isometry3d T_world_object =
+      Eigen::Isometry3d::Identity(); ///< object-to-world (metres)
+  bool moving =
+      false; ///< true when the object moves between the previous frame and this one
   /// Half sizes of the box along the object's x, y, z axes (metres); the box is centred
   /// on the object frame's origin.
   Eigen::Vector3d half_extents = Eigen::Vector3d::Zero();
@@ -33,11 +35,13 @@ struct ObjectState {
 
 /// One rendered frame with its ground truth.
 struct SynthFrame {
-  double timestamp = 0.0;       ///< seconds (colour stamp)
-  double depth_timestamp = 0.0; ///< seconds (depth stamp, a few ms after the colour one)
-  ColorImage color;             ///< shaded, textured colour image
-  DepthImage depth;             ///< metres after the depth model; NaN = no measurement
-  std::vector<std::uint8_t> labels; ///< per pixel: 0 static, k for object k while it moves
+  double timestamp = 0.0; ///< seconds (colour stamp)
+  double depth_timestamp =
+      0.0;          ///< seconds (depth stamp, a few ms after the colour one)
+  ColorImage color; ///< shaded, textured colour image
+  DepthImage depth; ///< metres after the depth model; NaN = no measurement
+  std::vector<std::uint8_t>
+      labels; ///< per pixel: 0 static, k for object k while it moves
   Eigen::Isometry3d T_world_camera = Eigen::Isometry3d::Identity(); ///< camera-to-world
   std::vector<ObjectState> objects; ///< every object of the scenario
 };
@@ -46,17 +50,17 @@ struct SynthFrame {
 struct DYNVO_EXPORTS SynthOptions {
   std::string scenario = "moving_crossing"; ///< one of SceneSynthesizer::scenarios()
   int frames = 300;                         ///< number of frames (> 0)
-  std::uint32_t seed = 0;                   ///< seeds textures' jitter and the depth noise
-  int width = 640;                          ///< image columns (px)
-  int height = 480;                         ///< image rows (px)
-  double fps = 30.0;                        ///< frame rate (Hz)
-  bool noise = true; ///< Kinect-like depth model on; off = exact depth, no holes or dropouts
+  std::uint32_t seed = 0; ///< seeds textures' jitter and the depth noise
+  int width = 640;        ///< image columns (px)
+  int height = 480;       ///< image rows (px)
+  double fps = 30.0;      ///< frame rate (Hz)
+  bool noise =
+      true; ///< Kinect-like depth model on; off = exact depth, no holes or dropouts
   /// Intrinsics at 640x480 (scaled with width/height); the "default" preset.
   CameraIntrinsics intrinsics;
 
   /// \throws std::invalid_argument on an unknown scenario or an out-of-range value
-  void
-  validate() const;
+  void validate() const;
 };
 
 /** \brief Renders scripted dynamic scenes by ray casting (deterministic for a seed).
@@ -101,14 +105,15 @@ struct DYNVO_EXPORTS SynthOptions {
  */
 class DYNVO_EXPORTS SceneSynthesizer {
 public:
-  static constexpr double MIN_DEPTH = 0.5;             ///< nearest measurable depth (m)
-  static constexpr double MAX_DEPTH = 4.5;             ///< farthest measurable depth (m)
+  static constexpr double MIN_DEPTH = 0.5; ///< nearest measurable depth (m)
+  static constexpr double MAX_DEPTH = 4.5; ///< farthest measurable depth (m)
   static constexpr double NOISE_SIGMA_PER_Z2 = 1.2e-3; ///< noise sigma / z^2 (1/m)
   /// Kinect inverse-depth step (1/m): 1/8 px disparity / (0.075 m baseline * 580 px).
   static constexpr double INVERSE_DEPTH_STEP = 0.125 / (0.075 * 580.0);
-  static constexpr double DROPOUT_RATE = 0.01;   ///< fraction of pixels randomly lost
-  static constexpr double EDGE_JUMP_RATIO = 0.05; ///< depth jump (fraction of z) making a hole
-  static constexpr double FIRST_STAMP = 1.0;       ///< colour stamp of frame 0 (s)
+  static constexpr double DROPOUT_RATE = 0.01; ///< fraction of pixels randomly lost
+  static constexpr double EDGE_JUMP_RATIO =
+      0.05; ///< depth jump (fraction of z) making a hole
+  static constexpr double FIRST_STAMP = 1.0;         ///< colour stamp of frame 0 (s)
   static constexpr double DEPTH_STAMP_DELAY = 0.005; ///< depth stamp - colour stamp (s)
   static constexpr double DEPTH_PNG_SCALE = 5000.0;  ///< depth PNG units per metre
 
@@ -117,17 +122,14 @@ public:
   ~SceneSynthesizer();
 
   /// Every scenario, in a fixed order.
-  static std::vector<ScenarioInfo>
-  scenarios();
+  static std::vector<ScenarioInfo> scenarios();
 
   /// Intrinsics actually used (scaled to the image size).
-  CameraIntrinsics
-  intrinsics() const;
+  CameraIntrinsics intrinsics() const;
 
   /// Render frame k (0 <= k < frames). Independent of call order; thread-safe.
   /// \throws std::invalid_argument when k is out of range
-  SynthFrame
-  render(int k) const;
+  SynthFrame render(int k) const;
 
   /** \brief Write the whole sequence in the TUM layout: rgb/, depth/ (16-bit, 5000 per
    * metre), labels/ (uint8), rgb.txt, depth.txt, groundtruth.txt, objects.txt.
@@ -140,8 +142,7 @@ public:
    * \throws pcl::IOException when the folder is not empty or cannot be written
    * \throws std::invalid_argument when threads < 1
    */
-  void
-  writeSequence(const std::string& folder, int threads) const;
+  void writeSequence(const std::string& folder, int threads) const;
 
 private:
   struct Impl;

@@ -15,7 +15,6 @@ namespace dynvo {
  * machine run the program under `xvfb-run -a`.
  * \param[out] reason when not null and the answer is false: why, in one line
  */
-DYNVO_EXPORTS bool
-displayAvailable(std::string* reason = nullptr);
+DYNVO_EXPORTS bool displayAvailable(std::string* reason = nullptr);
 
 } // namespace dynvo

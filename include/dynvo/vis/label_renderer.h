@@ -21,9 +21,9 @@ namespace dynvo {
 
 /// Where a LabelRenderer looks from.
 enum class RenderView {
-  camera,  ///< the recording camera itself: the PNG lines up pixel for pixel with the RGB frame
+  camera, ///< the recording camera itself: the PNG lines up pixel for pixel with the RGB frame
   oblique, ///< behind, above and right of the current camera, looking at the whole scene
-  top,     ///< straight down the world -y axis (camera 0's "up"), world +z pointing up in the image
+  top, ///< straight down the world -y axis (camera 0's "up"), world +z pointing up in the image
 };
 
 /** \brief Renders a cloud coloured by label into a PNG with VTK, off screen.
@@ -55,18 +55,22 @@ class DYNVO_EXPORTS LabelRenderer {
 public:
   /// Rendering settings; defaults match a 640x480 TUM-style camera.
   struct Parameters {
-    std::uint32_t width = 640;  ///< image columns (px); the recording's width for the camera view
-    std::uint32_t height = 480; ///< image rows (px); the recording's height for the camera view
-    CameraIntrinsics intrinsics; ///< recording camera (px), used by the camera view and the frustum
+    std::uint32_t width =
+        640; ///< image columns (px); the recording's width for the camera view
+    std::uint32_t height =
+        480; ///< image rows (px); the recording's height for the camera view
+    CameraIntrinsics
+        intrinsics; ///< recording camera (px), used by the camera view and the frustum
     RenderView view = RenderView::camera; ///< viewpoint
-    double rgb_blend = 0.3;     ///< share of the point's own RGB in its colour, in [0, 1]
-    double point_size = 2.0;    ///< point diameter (px) in the oblique and top views, >= 1;
-                                ///< the camera view draws each point on its own pixel
-    double frustum_depth = 0.3; ///< distance of the drawn frustum's far face (metres), > 0
+    double rgb_blend = 0.3; ///< share of the point's own RGB in its colour, in [0, 1]
+    double point_size =
+        2.0; ///< point diameter (px) in the oblique and top views, >= 1;
+             ///< the camera view draws each point on its own pixel
+    double frustum_depth =
+        0.3; ///< distance of the drawn frustum's far face (metres), > 0
 
     /// Throws std::invalid_argument naming the first field out of range.
-    void
-    validate() const;
+    void validate() const;
   };
 
   LabelRenderer();
@@ -74,34 +78,19 @@ public:
   explicit LabelRenderer(const Parameters& params);
   ~LabelRenderer();
   LabelRenderer(LabelRenderer&&) noexcept;
-  LabelRenderer&
-  operator=(LabelRenderer&&) noexcept;
+  LabelRenderer& operator=(LabelRenderer&&) noexcept;
   LabelRenderer(const LabelRenderer&) = delete;
-  LabelRenderer&
-  operator=(const LabelRenderer&) = delete;
+  LabelRenderer& operator=(const LabelRenderer&) = delete;
 
   /// \throws std::invalid_argument when params.validate() fails (the old settings stay)
-  void
-  setParameters(const Parameters& params);
+  void setParameters(const Parameters& params);
 
-  const Parameters&
-  getParameters() const
-  {
-    return params_;
-  }
+  const Parameters& getParameters() const { return params_; }
 
   /// Viewpoint of the next render().
-  void
-  setView(RenderView view)
-  {
-    params_.view = view;
-  }
+  void setView(RenderView view) { params_.view = view; }
 
-  RenderView
-  getView() const
-  {
-    return params_.view;
-  }
+  RenderView getView() const { return params_.view; }
 
   /** \brief Renders one frame into a PNG (created or replaced).
    * \param[in] cloud points in the camera frame (metres); NaN points are skipped
@@ -114,32 +103,27 @@ public:
    *         differ, the cloud is empty or the file cannot be written, and false (with one PCL_WARN
    *         per renderer) when no display is available
    */
-  bool
-  render(const pcl::PointCloud<pcl::PointXYZRGB>& cloud,
-         const std::vector<std::uint8_t>& labels,
-         const Eigen::Isometry3d& T_world_camera,
-         const Trajectory& trajectory_so_far,
-         const std::string& out_png);
+  bool render(const pcl::PointCloud<pcl::PointXYZRGB>& cloud,
+              const std::vector<std::uint8_t>& labels,
+              const Eigen::Isometry3d& T_world_camera,
+              const Trajectory& trajectory_so_far,
+              const std::string& out_png);
 
   /// Palette colour (R, G, B) of a label, before blending with the point's RGB.
-  static std::array<std::uint8_t, 3>
-  labelColor(std::uint8_t label);
+  static std::array<std::uint8_t, 3> labelColor(std::uint8_t label);
 
   /// Rendered colour of a point: labelColor(label) mixed with rgb at ratio rgb_blend, rounded.
-  static std::array<std::uint8_t, 3>
-  blendedColor(std::uint8_t label, const std::array<std::uint8_t, 3>& rgb, double rgb_blend);
+  static std::array<std::uint8_t, 3> blendedColor(
+      std::uint8_t label, const std::array<std::uint8_t, 3>& rgb, double rgb_blend);
 
-  static const char*
-  getClassName()
-  {
-    return "LabelRenderer";
-  }
+  static const char* getClassName() { return "LabelRenderer"; }
 
 private:
   struct Impl;
-  Parameters params_;            ///< current settings
-  std::unique_ptr<Impl> impl_; ///< X connection and VTK pipeline, made by the first render
-  bool no_display_ = false;    ///< the first render found no display (and warned)
+  Parameters params_; ///< current settings
+  std::unique_ptr<Impl>
+      impl_;                ///< X connection and VTK pipeline, made by the first render
+  bool no_display_ = false; ///< the first render found no display (and warned)
 };
 
 } // namespace dynvo

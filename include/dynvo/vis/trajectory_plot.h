@@ -20,15 +20,17 @@ enum class PlotPlane {
 /// Settings of writeTrajectoryPlot().
 struct DYNVO_EXPORTS TrajectoryPlotOptions {
   PlotPlane plane = PlotPlane::xz; ///< top-down plane
-  std::uint32_t width = 1280;      ///< PNG columns (px); the charts share it side by side
-  std::uint32_t height = 480;      ///< PNG rows (px)
-  double max_time_difference = 0.02; ///< stamp association for the error curve (seconds)
-  std::array<std::uint8_t, 3> estimate_color{31, 119, 180};   ///< estimate curve (R, G, B)
-  std::array<std::uint8_t, 3> groundtruth_color{214, 39, 40}; ///< ground-truth curve (R, G, B)
+  std::uint32_t width = 1280; ///< PNG columns (px); the charts share it side by side
+  std::uint32_t height = 480; ///< PNG rows (px)
+  double max_time_difference =
+      0.02; ///< stamp association for the error curve (seconds)
+  std::array<std::uint8_t, 3> estimate_color{31, 119,
+                                             180}; ///< estimate curve (R, G, B)
+  std::array<std::uint8_t, 3> groundtruth_color{214, 39,
+                                                40}; ///< ground-truth curve (R, G, B)
 
   /// Throws std::invalid_argument naming the first field out of range.
-  void
-  validate() const;
+  void validate() const;
 };
 
 /** \brief Writes a PNG of VTK charts: the top-down path of the estimate (and of the ground
@@ -44,10 +46,9 @@ struct DYNVO_EXPORTS TrajectoryPlotOptions {
  *         PCL_WARN) otherwise
  * \throws std::invalid_argument when options.validate() fails
  */
-DYNVO_EXPORTS bool
-writeTrajectoryPlot(const Trajectory& estimate,
-                    const Trajectory& groundtruth,
-                    const std::string& out_png,
-                    const TrajectoryPlotOptions& options = {});
+DYNVO_EXPORTS bool writeTrajectoryPlot(const Trajectory& estimate,
+                                       const Trajectory& groundtruth,
+                                       const std::string& out_png,
+                                       const TrajectoryPlotOptions& options = {});
 
 } // namespace dynvo

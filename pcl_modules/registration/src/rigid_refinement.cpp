@@ -21,7 +21,8 @@ runRefinement(RegistrationT& registration,
 {
   registration.setInputSource(source);
   registration.setInputTarget(target);
-  registration.setMaxCorrespondenceDistance(parameters.refinement_max_correspondence_distance);
+  registration.setMaxCorrespondenceDistance(
+      parameters.refinement_max_correspondence_distance);
   registration.setMaximumIterations(parameters.refinement_max_iterations);
   registration.setTransformationEpsilon(parameters.refinement_transformation_epsilon);
   pcl::PointCloud<pcl::PointXYZ> aligned;

@@ -11,8 +11,8 @@ void
 StaticSceneRegistrationParameters::validate() const
 {
   const auto fail = [](const std::string& what) {
-    throw std::invalid_argument("[dynvo::StaticSceneRegistration::Parameters::validate] " +
-                                what);
+    throw std::invalid_argument(
+        "[dynvo::StaticSceneRegistration::Parameters::validate] " + what);
   };
   if (!(std::isfinite(th_inlier) && th_inlier > 0.0f))
     fail("th_inlier must be finite and > 0 m^2, got " + std::to_string(th_inlier));
@@ -24,7 +24,8 @@ StaticSceneRegistrationParameters::validate() const
     fail("min_correspondences must be >= 3 (a rigid fit needs 3 points), got " +
          std::to_string(min_correspondences));
   if (refinement != RegistrationRefinement::none &&
-      refinement != RegistrationRefinement::icp && refinement != RegistrationRefinement::gicp)
+      refinement != RegistrationRefinement::icp &&
+      refinement != RegistrationRefinement::gicp)
     fail("refinement must be none, icp or gicp, got " +
          std::to_string(static_cast<int>(refinement)));
   if (!(std::isfinite(refinement_max_correspondence_distance) &&

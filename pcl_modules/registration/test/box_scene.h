@@ -21,14 +21,14 @@ namespace dynvo::test {
 
 /// An oriented box: |x_k| <= half_size_k in its own frame.
 struct Box {
-  Eigen::Isometry3d T_world_box = Eigen::Isometry3d::Identity(); ///< box-to-world (metres)
-  Eigen::Vector3d half_size = Eigen::Vector3d::Ones();           ///< metres
+  Eigen::Isometry3d T_world_box =
+      Eigen::Isometry3d::Identity();                   ///< box-to-world (metres)
+  Eigen::Vector3d half_size = Eigen::Vector3d::Ones(); ///< metres
   bool moving = false; ///< moves by BoxScene::object_motion between the frames
 };
 
 /// Organized cloud plus the index of the box seen at each pixel (-1 = nothing).
-template <typename PointT>
-struct RenderedFrame {
+template <typename PointT> struct RenderedFrame {
   typename pcl::PointCloud<PointT>::Ptr cloud;
   std::vector<int> box;
 };
@@ -37,7 +37,8 @@ inline Eigen::Isometry3d
 rigid(const Eigen::Vector3d& axis, double angle_deg, const Eigen::Vector3d& translation)
 {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Eigen::AngleAxisd(angle_deg * M_PI / 180.0, axis.normalized()).toRotationMatrix();
+  T.linear() =
+      Eigen::AngleAxisd(angle_deg * M_PI / 180.0, axis.normalized()).toRotationMatrix();
   T.translation() = translation;
   return T;
 }
@@ -45,7 +46,9 @@ rigid(const Eigen::Vector3d& axis, double angle_deg, const Eigen::Vector3d& tran
 /// Ray parameter where o + s d enters the box |x_k| <= half_k (slab method); +inf on a miss or
 /// when the entry lies behind the origin.
 inline double
-hitDepth(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Eigen::Vector3d& half)
+hitDepth(const Eigen::Vector3d& o,
+         const Eigen::Vector3d& d,
+         const Eigen::Vector3d& half)
 {
   double enter = -std::numeric_limits<double>::infinity();
   double leave = std::numeric_limits<double>::infinity();
@@ -60,7 +63,8 @@ hitDepth(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Eigen::Vector
     enter = std::max(enter, std::min(s1, s2));
     leave = std::min(leave, std::max(s1, s2));
   }
-  return enter <= leave && enter > 0.0 ? enter : std::numeric_limits<double>::infinity();
+  return enter <= leave && enter > 0.0 ? enter
+                                       : std::numeric_limits<double>::infinity();
 }
 
 /** \brief A room corner (back wall, floor, left wall), a static tilted box and a moving box.
@@ -69,15 +73,16 @@ hitDepth(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Eigen::Vector
  */
 struct BoxScene {
   std::vector<Box> boxes;
-  Eigen::Isometry3d T_curr_prev = Eigen::Isometry3d::Identity(); ///< camera motion (H_k)
-  Eigen::Isometry3d object_motion = Eigen::Isometry3d::Identity(); ///< world motion of moving boxes
-  CameraIntrinsics intrinsics; ///< of a width x height image
+  Eigen::Isometry3d T_curr_prev =
+      Eigen::Isometry3d::Identity(); ///< camera motion (H_k)
+  Eigen::Isometry3d object_motion =
+      Eigen::Isometry3d::Identity(); ///< world motion of moving boxes
+  CameraIntrinsics intrinsics;       ///< of a width x height image
   std::uint32_t width = 160;
   std::uint32_t height = 120;
 
   /// The scene at 160x120 (or any size with the same field of view as 640x480 at f = 525).
-  static BoxScene
-  make(std::uint32_t width = 160, std::uint32_t height = 120)
+  static BoxScene make(std::uint32_t width = 160, std::uint32_t height = 120)
   {
     BoxScene scene;
     scene.width = width;
@@ -86,15 +91,18 @@ struct BoxScene {
     scene.intrinsics.fx = scene.intrinsics.fy = 525.0 * scale;
     scene.intrinsics.cx = (width - 1) / 2.0;
     scene.intrinsics.cy = (height - 1) / 2.0;
-    const auto add = [&scene](const Eigen::Isometry3d& pose, Eigen::Vector3d half, bool moving) {
+    const auto add = [&scene](const Eigen::Isometry3d& pose, Eigen::Vector3d half,
+                              bool moving) {
       scene.boxes.push_back(Box{pose, half, moving});
     };
     const Eigen::Vector3d y = Eigen::Vector3d::UnitY();
-    add(rigid(y, 0.0, {0.0, 0.0, 3.5}), {3.0, 3.0, 0.05}, false);    // back wall
-    add(rigid(y, 0.0, {0.0, 0.9, 2.0}), {3.0, 0.05, 2.5}, false);    // floor (y points down)
-    add(rigid(y, 0.0, {-1.5, 0.0, 2.0}), {0.05, 3.0, 2.5}, false);   // left wall
-    add(rigid(y, 30.0, {0.6, 0.55, 2.4}), {0.25, 0.3, 0.25}, false); // static tilted box
-    add(rigid(y, 0.0, {-0.3, -0.1, 1.6}), {0.3, 0.3, 0.2}, true);    // moving object
+    add(rigid(y, 0.0, {0.0, 0.0, 3.5}), {3.0, 3.0, 0.05}, false); // back wall
+    add(rigid(y, 0.0, {0.0, 0.9, 2.0}), {3.0, 0.05, 2.5},
+        false); // floor (y points down)
+    add(rigid(y, 0.0, {-1.5, 0.0, 2.0}), {0.05, 3.0, 2.5}, false); // left wall
+    add(rigid(y, 30.0, {0.6, 0.55, 2.4}), {0.25, 0.3, 0.25},
+        false);                                                   // static tilted box
+    add(rigid(y, 0.0, {-0.3, -0.1, 1.6}), {0.3, 0.3, 0.2}, true); // moving object
     scene.T_curr_prev = rigid({0.3, 1.0, 0.2}, 2.0, {0.02, -0.01, 0.03});
     scene.object_motion = rigid({0.0, 0.0, 1.0}, 10.0, {0.12, 0.0, -0.05});
     return scene;
@@ -104,12 +112,12 @@ struct BoxScene {
    * tilted boxes at 1.2-1.8 m seen at steep angles. (The room of make() shows the floor at
    * grazing angles, where 160x120 samples lie 8 cm apart in depth: too sparse for ICP.)
    */
-  static BoxScene
-  makeClutter()
+  static BoxScene makeClutter()
   {
     BoxScene scene = make();
     scene.boxes.clear();
-    const auto add = [&scene](const Eigen::Isometry3d& pose, Eigen::Vector3d half, bool moving) {
+    const auto add = [&scene](const Eigen::Isometry3d& pose, Eigen::Vector3d half,
+                              bool moving) {
       scene.boxes.push_back(Box{pose, half, moving});
     };
     add(rigid({0.0, 1.0, 0.0}, 0.0, {0.0, 0.0, 2.2}), {3.0, 3.0, 0.05}, false);
@@ -122,16 +130,13 @@ struct BoxScene {
   }
 
   /// Box pose at the previous (current = false) or current (true) frame.
-  Eigen::Isometry3d
-  boxPose(const Box& box, bool current) const
+  Eigen::Isometry3d boxPose(const Box& box, bool current) const
   {
     return current && box.moving ? object_motion * box.T_world_box : box.T_world_box;
   }
 
   /// Ray casts the previous (current = false) or current (current = true) frame.
-  template <typename PointT>
-  RenderedFrame<PointT>
-  render(bool current) const
+  template <typename PointT> RenderedFrame<PointT> render(bool current) const
   {
     const Eigen::Isometry3d T_world_cam =
         current ? T_curr_prev.inverse() : Eigen::Isometry3d::Identity();
@@ -147,7 +152,8 @@ struct BoxScene {
         double best = std::numeric_limits<double>::infinity();
         int best_box = -1;
         for (std::size_t b = 0; b < boxes.size(); ++b) {
-          const Eigen::Isometry3d T_box_cam = boxPose(boxes[b], current).inverse() * T_world_cam;
+          const Eigen::Isometry3d T_box_cam =
+              boxPose(boxes[b], current).inverse() * T_world_cam;
           const double z = hitDepth(T_box_cam * Eigen::Vector3d::Zero(),
                                     T_box_cam.linear() * d_cam, boxes[b].half_size);
           if (z < best) {
@@ -174,9 +180,9 @@ struct BoxScene {
    * \param[out] static_cell per cell: 1 when its centre sees a static box
    */
   template <typename PointT>
-  pcl::PointCloud<PointFlow>
-  flow(const RenderedFrame<PointT>& current, std::uint32_t cell_size,
-       std::vector<std::uint8_t>& static_cell) const
+  pcl::PointCloud<PointFlow> flow(const RenderedFrame<PointT>& current,
+                                  std::uint32_t cell_size,
+                                  std::vector<std::uint8_t>& static_cell) const
   {
     const std::uint32_t cols = width / cell_size, rows = height / cell_size;
     pcl::PointCloud<PointFlow> grid(cols, rows);
@@ -197,7 +203,8 @@ struct BoxScene {
           f.valid_2d = f.valid_3d = 0;
           continue;
         }
-        const Eigen::Vector3d b = (*current.cloud)(u, v).getVector3fMap().template cast<double>();
+        const Eigen::Vector3d b =
+            (*current.cloud)(u, v).getVector3fMap().template cast<double>();
         // World = previous camera frame; a moving point is moved back by the object motion.
         Eigen::Vector3d a = T_prev_curr * b;
         if (boxes[box].moving)
@@ -220,8 +227,10 @@ struct BoxScene {
 
 /// Every pixel of the cells flagged in cell_mask (cell_size px cells on a width-wide image).
 inline pcl::PointIndices::Ptr
-cellPixels(const std::vector<std::uint8_t>& cell_mask, std::uint32_t cols,
-           std::uint32_t cell_size, std::uint32_t width)
+cellPixels(const std::vector<std::uint8_t>& cell_mask,
+           std::uint32_t cols,
+           std::uint32_t cell_size,
+           std::uint32_t width)
 {
   pcl::PointIndices::Ptr indices(new pcl::PointIndices);
   for (std::size_t i = 0; i < cell_mask.size(); ++i) {
@@ -244,7 +253,8 @@ rotationErrorDeg(const Eigen::Matrix4f& A, const Eigen::Matrix4d& B)
 {
   const Eigen::Matrix3d dR =
       A.topLeftCorner<3, 3>().cast<double>().transpose() * B.topLeftCorner<3, 3>();
-  const Eigen::Vector3d skew(dR(2, 1) - dR(1, 2), dR(0, 2) - dR(2, 0), dR(1, 0) - dR(0, 1));
+  const Eigen::Vector3d skew(dR(2, 1) - dR(1, 2), dR(0, 2) - dR(2, 0),
+                             dR(1, 0) - dR(0, 1));
   return std::atan2(skew.norm() / 2.0, (dR.trace() - 1.0) / 2.0) * 180.0 / M_PI;
 }
 

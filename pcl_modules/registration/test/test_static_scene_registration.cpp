@@ -32,8 +32,7 @@ constexpr double TRANSLATION_TOL = 1e-3; // metres
 constexpr double ROTATION_TOL = 0.05;    // degrees
 
 /// A frame pair of the box scene with its flow grid and the static cells.
-template <typename PointT>
-struct FramePair {
+template <typename PointT> struct FramePair {
   dynvo::test::RenderedFrame<PointT> previous;
   dynvo::test::RenderedFrame<PointT> current;
   pcl::PointCloud<dynvo::PointFlow>::Ptr flow;
@@ -41,37 +40,37 @@ struct FramePair {
   std::uint32_t cols = 0;
 
   explicit FramePair(const BoxScene& scene)
-  : previous(scene.render<PointT>(false)), current(scene.render<PointT>(true))
+      : previous(scene.render<PointT>(false))
+      , current(scene.render<PointT>(true))
   {
-    flow.reset(new pcl::PointCloud<dynvo::PointFlow>(scene.flow(current, CELL, static_cells)));
+    flow.reset(
+        new pcl::PointCloud<dynvo::PointFlow>(scene.flow(current, CELL, static_cells)));
     cols = scene.width / CELL;
   }
 
   /// Every pixel of the static cells.
-  pcl::PointIndices::Ptr
-  staticPixels(std::uint32_t width) const
+  pcl::PointIndices::Ptr staticPixels(std::uint32_t width) const
   {
     return cellPixels(static_cells, cols, CELL, width);
   }
 
   /// The pixels of the static cells that see a static box (cells at the moving box's border
   /// also hold some of its pixels, which a point-based refinement must not get).
-  pcl::PointIndices::Ptr
-  staticSurfacePixels(const BoxScene& scene) const
+  pcl::PointIndices::Ptr staticSurfacePixels(const BoxScene& scene) const
   {
     pcl::PointIndices::Ptr indices = staticPixels(scene.width);
     auto& list = indices->indices;
     list.erase(std::remove_if(list.begin(), list.end(),
                               [&](int index) {
-                                const int box = current.box[static_cast<std::size_t>(index)];
+                                const int box =
+                                    current.box[static_cast<std::size_t>(index)];
                                 return box < 0 || scene.boxes[box].moving;
                               }),
                list.end());
     return indices;
   }
 
-  std::size_t
-  staticCellCount() const
+  std::size_t staticCellCount() const
   {
     std::size_t n = 0;
     for (const auto s : static_cells)
@@ -80,8 +79,8 @@ struct FramePair {
   }
 };
 
-template <typename PointT>
-class StaticSceneRegistrationTyped : public ::testing::Test {};
+template <typename PointT> class StaticSceneRegistrationTyped : public ::testing::Test {
+};
 using PointTypes = ::testing::Types<pcl::PointXYZRGB, pcl::PointXYZRGBA>;
 TYPED_TEST_SUITE(StaticSceneRegistrationTyped, PointTypes);
 
@@ -100,9 +99,11 @@ TYPED_TEST(StaticSceneRegistrationTyped, SameFrameTwiceGivesIdentity)
   registration.align(aligned);
   ASSERT_TRUE(registration.hasConverged());
   EXPECT_EQ(registration.getStatus(), StaticRegistrationStatus::converged);
-  EXPECT_LT(rotationErrorDeg(registration.getFinalTransformation(), Eigen::Matrix4d::Identity()),
+  EXPECT_LT(rotationErrorDeg(registration.getFinalTransformation(),
+                             Eigen::Matrix4d::Identity()),
             ROTATION_TOL);
-  EXPECT_LT(translationError(registration.getFinalTransformation(), Eigen::Matrix4d::Identity()),
+  EXPECT_LT(translationError(registration.getFinalTransformation(),
+                             Eigen::Matrix4d::Identity()),
             TRANSLATION_TOL);
   EXPECT_EQ(registration.getNumberOfCorrespondences(), pair.staticCellCount());
   EXPECT_EQ(registration.getNumberOfInliers(), pair.staticCellCount());
@@ -130,9 +131,11 @@ TYPED_TEST(StaticSceneRegistrationTyped, RecoversAKnownMotionForwardAndInverse)
     ASSERT_TRUE(registration.hasConverged()) << "inverse " << inverse;
     // getFinalTransformation() is T_prev_curr, the inverse of the paper's H_k = T_curr_prev.
     const Eigen::Matrix4d truth = scene.T_curr_prev.inverse().matrix();
-    EXPECT_LT(rotationErrorDeg(registration.getFinalTransformation(), truth), ROTATION_TOL)
+    EXPECT_LT(rotationErrorDeg(registration.getFinalTransformation(), truth),
+              ROTATION_TOL)
         << "inverse " << inverse;
-    EXPECT_LT(translationError(registration.getFinalTransformation(), truth), TRANSLATION_TOL)
+    EXPECT_LT(translationError(registration.getFinalTransformation(), truth),
+              TRANSLATION_TOL)
         << "inverse " << inverse;
     // The moving box's cells were never selected, so nothing was trimmed.
     EXPECT_EQ(registration.getNumberOfInliers(), pair.staticCellCount());
@@ -163,7 +166,8 @@ TYPED_TEST(StaticSceneRegistrationTyped, TooFewStaticCellsDoNotConverge)
   pcl::PointCloud<TypeParam> aligned;
   registration.align(aligned, prediction);
   EXPECT_FALSE(registration.hasConverged());
-  EXPECT_EQ(registration.getStatus(), StaticRegistrationStatus::too_few_correspondences);
+  EXPECT_EQ(registration.getStatus(),
+            StaticRegistrationStatus::too_few_correspondences);
   EXPECT_EQ(registration.getNumberOfCorrespondences(), 5u);
   EXPECT_EQ(registration.getFinalTransformation(), prediction);
   EXPECT_EQ(registration.getFitnessScore(), std::numeric_limits<double>::max());
@@ -178,7 +182,9 @@ using Point = pcl::PointXYZRGB;
 
 class StaticSceneRegistrationTest : public ::testing::Test {
 protected:
-  StaticSceneRegistrationTest() : scene_(BoxScene::make()), pair_(scene_)
+  StaticSceneRegistrationTest()
+      : scene_(BoxScene::make())
+      , pair_(scene_)
   {
     registration_.setInputSource(pair_.current.cloud);
     registration_.setInputTarget(pair_.previous.cloud);
@@ -186,15 +192,10 @@ protected:
     registration_.setInputFlow(pair_.flow);
   }
 
-  Eigen::Matrix4d
-  truth() const
-  {
-    return scene_.T_curr_prev.inverse().matrix();
-  }
+  Eigen::Matrix4d truth() const { return scene_.T_curr_prev.inverse().matrix(); }
 
   /// Runs align() and returns stderr, where PCL_ERROR writes.
-  std::string
-  alignCapturingErrors()
+  std::string alignCapturingErrors()
   {
     ::testing::internal::CaptureStderr();
     registration_.align(aligned_);
@@ -220,7 +221,8 @@ TEST_F(StaticSceneRegistrationTest, CellCentresAndWholeCellsSelectTheSameCells)
   registration_.align(aligned_);
   ASSERT_TRUE(registration_.hasConverged());
   EXPECT_EQ(registration_.getNumberOfCorrespondences(), pair_.staticCellCount());
-  EXPECT_LT(translationError(registration_.getFinalTransformation(), truth()), TRANSLATION_TOL);
+  EXPECT_LT(translationError(registration_.getFinalTransformation(), truth()),
+            TRANSLATION_TOL);
   EXPECT_EQ(aligned_.size(), centres->indices.size());
 }
 
@@ -239,7 +241,8 @@ TEST_F(StaticSceneRegistrationTest, OutliersInTheStaticSetAreTrimmed)
 {
   // Five static cells get a 5 cm error in the same direction (a bad depth or track):
   // E = 2.5e-3 m^2 >> 4 th_inlier = 1.2e-4 m^2, so the trimming drops exactly these.
-  pcl::PointCloud<dynvo::PointFlow>::Ptr corrupted(new pcl::PointCloud<dynvo::PointFlow>(*pair_.flow));
+  pcl::PointCloud<dynvo::PointFlow>::Ptr corrupted(
+      new pcl::PointCloud<dynvo::PointFlow>(*pair_.flow));
   int outliers = 0;
   for (std::size_t i = 0; i < corrupted->size() && outliers < 5; i += 7)
     if (pair_.static_cells[i]) {
@@ -251,13 +254,17 @@ TEST_F(StaticSceneRegistrationTest, OutliersInTheStaticSetAreTrimmed)
   registration_.setTrimRounds(0);
   registration_.align(aligned_);
   ASSERT_TRUE(registration_.hasConverged());
-  const double untrimmed = translationError(registration_.getFinalTransformation(), truth());
-  EXPECT_GT(untrimmed, TRANSLATION_TOL) << "the outliers must matter for this test to mean anything";
+  const double untrimmed =
+      translationError(registration_.getFinalTransformation(), truth());
+  EXPECT_GT(untrimmed, TRANSLATION_TOL)
+      << "the outliers must matter for this test to mean anything";
   registration_.setTrimRounds(2);
   registration_.align(aligned_);
   ASSERT_TRUE(registration_.hasConverged());
-  EXPECT_LT(rotationErrorDeg(registration_.getFinalTransformation(), truth()), ROTATION_TOL);
-  EXPECT_LT(translationError(registration_.getFinalTransformation(), truth()), TRANSLATION_TOL);
+  EXPECT_LT(rotationErrorDeg(registration_.getFinalTransformation(), truth()),
+            ROTATION_TOL);
+  EXPECT_LT(translationError(registration_.getFinalTransformation(), truth()),
+            TRANSLATION_TOL);
   EXPECT_EQ(registration_.getNumberOfInliers(), pair_.staticCellCount() - 5);
   // The kept cells are exact, so the fitness is round-off, below (10 um)^2.
   EXPECT_LT(registration_.getFitnessScore(), 1e-10);
@@ -286,8 +293,9 @@ TEST_F(StaticSceneRegistrationTest, CollinearStaticCellsAreDegenerate)
 
 /// A flow grid built with a slightly wrong motion (0.5 degrees, 1 cm): the flow estimate is off
 /// by exactly that, and the refinement must pull it back using the clouds themselves.
-class RefinementTest : public StaticSceneRegistrationTest,
-                       public ::testing::WithParamInterface<dynvo::RegistrationRefinement> {};
+class RefinementTest
+    : public StaticSceneRegistrationTest,
+      public ::testing::WithParamInterface<dynvo::RegistrationRefinement> {};
 
 TEST_P(RefinementTest, ConvergesFromASlightlyWrongFlowEstimate)
 {
@@ -299,7 +307,8 @@ TEST_P(RefinementTest, ConvergesFromASlightlyWrongFlowEstimate)
   registration_.setInputSource(pair_.current.cloud);
   registration_.setInputTarget(pair_.previous.cloud);
   BoxScene biased = scene_;
-  biased.T_curr_prev = dynvo::test::rigid({1.0, -0.5, 0.3}, 0.5, {0.01, 0.0, 0.0}) * scene_.T_curr_prev;
+  biased.T_curr_prev =
+      dynvo::test::rigid({1.0, -0.5, 0.3}, 0.5, {0.01, 0.0, 0.0}) * scene_.T_curr_prev;
   std::vector<std::uint8_t> unused;
   registration_.setInputFlow(pcl::make_shared<pcl::PointCloud<dynvo::PointFlow>>(
       biased.flow(pair_.current, CELL, unused)));
@@ -323,7 +332,8 @@ TEST_P(RefinementTest, ConvergesFromASlightlyWrongFlowEstimate)
   EXPECT_LT(rotationErrorDeg(refined, truth()), gicp ? ROTATION_TOL : 0.45);
 }
 
-INSTANTIATE_TEST_SUITE_P(IcpAndGicp, RefinementTest,
+INSTANTIATE_TEST_SUITE_P(IcpAndGicp,
+                         RefinementTest,
                          ::testing::Values(dynvo::RegistrationRefinement::icp,
                                            dynvo::RegistrationRefinement::gicp));
 
@@ -399,7 +409,8 @@ TEST_F(StaticSceneRegistrationTest, MismatchedSizesAndBadIndicesAreRejected)
 
   // A 10x10 grid cannot tile 160x120 (cell size 16 gives 7 rows).
   registration_.setInputTarget(pair_.previous.cloud);
-  registration_.setInputFlow(pcl::make_shared<pcl::PointCloud<dynvo::PointFlow>>(10, 10));
+  registration_.setInputFlow(
+      pcl::make_shared<pcl::PointCloud<dynvo::PointFlow>>(10, 10));
   EXPECT_NE(alignCapturingErrors().find(PREFIX), std::string::npos);
   EXPECT_FALSE(registration_.hasConverged());
 
@@ -444,11 +455,14 @@ TEST(StaticSceneRegistrationParameters, DefaultsFollowTheAlgorithmAndBadValuesTh
   EXPECT_THROW(registration.setTrimFactor(0.5f), std::invalid_argument);
   EXPECT_THROW(registration.setTrimRounds(-1), std::invalid_argument);
   EXPECT_THROW(registration.setMinCorrespondences(2), std::invalid_argument);
-  EXPECT_THROW(registration.setRefinement(static_cast<dynvo::RegistrationRefinement>(7)),
+  EXPECT_THROW(
+      registration.setRefinement(static_cast<dynvo::RegistrationRefinement>(7)),
+      std::invalid_argument);
+  EXPECT_THROW(registration.setRefinementMaxCorrespondenceDistance(0.0),
                std::invalid_argument);
-  EXPECT_THROW(registration.setRefinementMaxCorrespondenceDistance(0.0), std::invalid_argument);
   EXPECT_THROW(registration.setRefinementMaxIterations(0), std::invalid_argument);
-  EXPECT_THROW(registration.setRefinementTransformationEpsilon(-1.0), std::invalid_argument);
+  EXPECT_THROW(registration.setRefinementTransformationEpsilon(-1.0),
+               std::invalid_argument);
   EXPECT_THROW(registration.setRefinementStride(0), std::invalid_argument);
   // A rejected value leaves the previous one in place.
   EXPECT_FLOAT_EQ(registration.getInlierThreshold(), 3e-5f);
@@ -478,12 +492,15 @@ TEST(StaticSceneRegistrationVga, VgaFramesWorkAndAMismatchedGridIsRejected)
   registration.align(aligned);
   ASSERT_TRUE(registration.hasConverged());
   const Eigen::Matrix4d truth = scene.T_curr_prev.inverse().matrix();
-  EXPECT_LT(rotationErrorDeg(registration.getFinalTransformation(), truth), ROTATION_TOL);
-  EXPECT_LT(translationError(registration.getFinalTransformation(), truth), TRANSLATION_TOL);
+  EXPECT_LT(rotationErrorDeg(registration.getFinalTransformation(), truth),
+            ROTATION_TOL);
+  EXPECT_LT(translationError(registration.getFinalTransformation(), truth),
+            TRANSLATION_TOL);
   EXPECT_EQ(registration.getNumberOfCorrespondences(), pair.staticCellCount());
 
   // 40x40 cells of 16 px would need 640 rows.
-  registration.setInputFlow(pcl::make_shared<pcl::PointCloud<dynvo::PointFlow>>(40, 40));
+  registration.setInputFlow(
+      pcl::make_shared<pcl::PointCloud<dynvo::PointFlow>>(40, 40));
   ::testing::internal::CaptureStderr();
   registration.align(aligned);
   EXPECT_NE(::testing::internal::GetCapturedStderr().find(PREFIX), std::string::npos);

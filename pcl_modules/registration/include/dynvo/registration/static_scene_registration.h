@@ -21,11 +21,11 @@ namespace dynvo {
 
 /// What the last align() produced (StaticSceneRegistration::getStatus()).
 enum class StaticRegistrationStatus {
-  not_computed,            ///< align() has not run yet
-  invalid_input,           ///< the inputs broke the contract (logged with PCL_ERROR); not converged
+  not_computed, ///< align() has not run yet
+  invalid_input, ///< the inputs broke the contract (logged with PCL_ERROR); not converged
   too_few_correspondences, ///< fewer than min_correspondences usable static cells; not converged
   degenerate,              ///< the static cells are (nearly) collinear; not converged
-  converged,               ///< the result is the trimmed flow estimate, refined if refinement != none
+  converged, ///< the result is the trimmed flow estimate, refined if refinement != none
   refinement_not_converged ///< converged, but ICP/GICP failed: the result is the flow estimate
 };
 
@@ -102,80 +102,42 @@ public:
   StaticSceneRegistration();
 
   /// Grid scene flow from the target (frame k-1) to the source (frame k), organized Gx x Gy.
-  void
-  setInputFlow(const FlowCloudConstPtr& flow)
-  {
-    flow_ = flow;
-  }
+  void setInputFlow(const FlowCloudConstPtr& flow) { flow_ = flow; }
 
-  const FlowCloudConstPtr&
-  getInputFlow() const
-  {
-    return flow_;
-  }
+  const FlowCloudConstPtr& getInputFlow() const { return flow_; }
 
   /// Estimates T_prev_curr; see the class doc. \param[out] output static points, moved
-  void
-  align(PointCloud& output)
-  {
-    align(output, Matrix4::Identity());
-  }
+  void align(PointCloud& output) { align(output, Matrix4::Identity()); }
 
   /** \brief Estimates T_prev_curr; see the class doc.
    * \param[out] output static points of the source moved into the target frame (unorganized)
    * \param[in] guess T_prev_curr returned by getFinalTransformation() when not converged
    */
-  void
-  align(PointCloud& output, const Matrix4& guess);
+  void align(PointCloud& output, const Matrix4& guess);
 
   /// Mean squared residual E_i (m^2) of the kept cells under the final transformation;
   /// std::numeric_limits<double>::max() when not converged.
-  double
-  getFitnessScore() const
-  {
-    return fitness_;
-  }
+  double getFitnessScore() const { return fitness_; }
 
   /// |S|: usable static cells of the last align() (0 for invalid input).
-  std::size_t
-  getNumberOfCorrespondences() const
-  {
-    return source_points_.size();
-  }
+  std::size_t getNumberOfCorrespondences() const { return source_points_.size(); }
 
   /// Cells kept by the trimming (the ones the flow estimate was fitted on).
-  std::size_t
-  getNumberOfInliers() const
-  {
-    return inlier_count_;
-  }
+  std::size_t getNumberOfInliers() const { return inlier_count_; }
 
-  Status
-  getStatus() const
-  {
-    return status_;
-  }
+  Status getStatus() const { return status_; }
 
   /// T_prev_curr of the trimmed flow estimate, before any refinement (the guess when it failed).
-  const Matrix4&
-  getFlowTransformation() const
-  {
-    return flow_transformation_;
-  }
+  const Matrix4& getFlowTransformation() const { return flow_transformation_; }
 
   /// All knobs at once. \throws std::invalid_argument when parameters.validate() fails
-  void
-  setParameters(const Parameters& parameters)
+  void setParameters(const Parameters& parameters)
   {
     parameters.validate();
     params_ = parameters;
   }
 
-  const Parameters&
-  getParameters() const
-  {
-    return params_;
-  }
+  const Parameters& getParameters() const { return params_; }
 
   // One setter/getter pair per field of Parameters; each throws std::invalid_argument on a
   // value out of the range documented in StaticSceneRegistrationParameters.
@@ -185,16 +147,37 @@ public:
   float getTrimFactor() const { return params_.trim_factor; }
   void setTrimRounds(int rounds) { updateField(&Parameters::trim_rounds, rounds); }
   int getTrimRounds() const { return params_.trim_rounds; }
-  void setMinCorrespondences(int cells) { updateField(&Parameters::min_correspondences, cells); }
+  void setMinCorrespondences(int cells)
+  {
+    updateField(&Parameters::min_correspondences, cells);
+  }
   int getMinCorrespondences() const { return params_.min_correspondences; }
-  void setRefinement(Refinement method) { updateField(&Parameters::refinement, method); }
+  void setRefinement(Refinement method)
+  {
+    updateField(&Parameters::refinement, method);
+  }
   Refinement getRefinement() const { return params_.refinement; }
-  void setRefinementMaxCorrespondenceDistance(double metres) { updateField(&Parameters::refinement_max_correspondence_distance, metres); }
-  double getRefinementMaxCorrespondenceDistance() const { return params_.refinement_max_correspondence_distance; }
-  void setRefinementMaxIterations(int iterations) { updateField(&Parameters::refinement_max_iterations, iterations); }
+  void setRefinementMaxCorrespondenceDistance(double metres)
+  {
+    updateField(&Parameters::refinement_max_correspondence_distance, metres);
+  }
+  double getRefinementMaxCorrespondenceDistance() const
+  {
+    return params_.refinement_max_correspondence_distance;
+  }
+  void setRefinementMaxIterations(int iterations)
+  {
+    updateField(&Parameters::refinement_max_iterations, iterations);
+  }
   int getRefinementMaxIterations() const { return params_.refinement_max_iterations; }
-  void setRefinementTransformationEpsilon(double m2) { updateField(&Parameters::refinement_transformation_epsilon, m2); }
-  double getRefinementTransformationEpsilon() const { return params_.refinement_transformation_epsilon; }
+  void setRefinementTransformationEpsilon(double m2)
+  {
+    updateField(&Parameters::refinement_transformation_epsilon, m2);
+  }
+  double getRefinementTransformationEpsilon() const
+  {
+    return params_.refinement_transformation_epsilon;
+  }
   void setRefinementStride(int px) { updateField(&Parameters::refinement_stride, px); }
   int getRefinementStride() const { return params_.refinement_stride; }
 
@@ -209,30 +192,23 @@ protected:
   using Base::transformation_;
 
   /// Runs the flow estimate and the optional refinement (called by pcl::Registration::align).
-  void
-  computeTransformation(PointCloud& output, const Matrix4& guess) override;
+  void computeTransformation(PointCloud& output, const Matrix4& guess) override;
 
   /// Non-null organized source, target and flow; equal source and target sizes; a flow grid
   /// matching the cloud (see the class doc); indices in range. Logs PCL_ERROR otherwise.
-  bool
-  validateInputs() const;
+  bool validateInputs() const;
 
   /// Collects S from the indices and the flow (fills source_points_, target_points_, weights_).
-  void
-  collectCorrespondences();
+  void collectCorrespondences();
 
   /// Weighted fit on S, then trimming. Sets status_, flow_transformation_ and inliers_.
-  bool
-  estimateFromFlow();
+  bool estimateFromFlow();
 
   /// ICP/GICP from flow_transformation_; true and writes refined when PCL reports convergence.
-  bool
-  refine(Matrix4& refined) const;
+  bool refine(Matrix4& refined) const;
 
 private:
-  template <typename Field>
-  void
-  updateField(Field Parameters::*field, Field value)
+  template <typename Field> void updateField(Field Parameters::*field, Field value)
   {
     Parameters updated = params_;
     updated.*field = value;
@@ -240,20 +216,20 @@ private:
   }
 
   /// Clears every result; the final transformation becomes the guess.
-  void
-  resetResults(const Matrix4& guess);
+  void resetResults(const Matrix4& guess);
 
-  Parameters params_;                          ///< validated knobs
-  FlowCloudConstPtr flow_;                     ///< grid scene flow k-1 -> k
-  Status status_ = Status::not_computed;       ///< outcome of the last align()
+  Parameters params_;                                   ///< validated knobs
+  FlowCloudConstPtr flow_;                              ///< grid scene flow k-1 -> k
+  Status status_ = Status::not_computed;                ///< outcome of the last align()
   double fitness_ = std::numeric_limits<double>::max(); ///< mean kept E_i (m^2)
-  Matrix4 flow_transformation_ = Matrix4::Identity();   ///< trimmed flow estimate T_prev_curr
-  std::size_t inlier_count_ = 0;               ///< cells the flow estimate was fitted on
+  Matrix4 flow_transformation_ =
+      Matrix4::Identity();       ///< trimmed flow estimate T_prev_curr
+  std::size_t inlier_count_ = 0; ///< cells the flow estimate was fitted on
   std::vector<Eigen::Vector3d> source_points_; ///< b_i of S (metres, current frame)
   std::vector<Eigen::Vector3d> target_points_; ///< a_i of S (metres, previous frame)
   std::vector<double> weights_;                ///< flow weight of each cell of S
-  std::vector<std::uint8_t> inliers_;          ///< 1 for the cells of S kept by the trimming
-  std::vector<std::uint8_t> static_cells_;     ///< per grid cell: selected by an index
+  std::vector<std::uint8_t> inliers_; ///< 1 for the cells of S kept by the trimming
+  std::vector<std::uint8_t> static_cells_; ///< per grid cell: selected by an index
 };
 
 } // namespace dynvo

@@ -13,8 +13,7 @@
 
 namespace dynvo {
 
-template <typename PointT>
-StaticSceneRegistration<PointT>::StaticSceneRegistration()
+template <typename PointT> StaticSceneRegistration<PointT>::StaticSceneRegistration()
 {
   reg_name_ = "StaticSceneRegistration";
   // The flow gives the correspondences: never build the base class's kd-tree on the target.
@@ -57,20 +56,21 @@ StaticSceneRegistration<PointT>::validateInputs() const
   const char* name = reg_name_.c_str();
   if (!input_ || !target_ || !flow_) {
     PCL_ERROR("[dynvo::%s::align] %s not set.\n", name,
-              !input_ ? "source (current) cloud" : !target_ ? "target (previous) cloud"
-                                                           : "flow grid (setInputFlow)");
+              !input_    ? "source (current) cloud"
+              : !target_ ? "target (previous) cloud"
+                         : "flow grid (setInputFlow)");
     return false;
   }
   if (!input_->isOrganized() || !target_->isOrganized() || !flow_->isOrganized()) {
     PCL_ERROR("[dynvo::%s::align] %s is not organized.\n", name,
-              !input_->isOrganized() ? "source (current) cloud"
+              !input_->isOrganized()    ? "source (current) cloud"
               : !target_->isOrganized() ? "target (previous) cloud"
                                         : "flow grid");
     return false;
   }
   if (input_->width != target_->width || input_->height != target_->height) {
-    PCL_ERROR("[dynvo::%s::align] source cloud is %ux%u but target cloud is %ux%u.\n", name,
-              input_->width, input_->height, target_->width, target_->height);
+    PCL_ERROR("[dynvo::%s::align] source cloud is %ux%u but target cloud is %ux%u.\n",
+              name, input_->width, input_->height, target_->width, target_->height);
     return false;
   }
   const std::uint32_t cell = flow_->width > 0 ? input_->width / flow_->width : 0;
@@ -83,8 +83,9 @@ StaticSceneRegistration<PointT>::validateInputs() const
   if (indices_ && !fake_indices_) {
     for (const auto index : *indices_) {
       if (index < 0 || static_cast<std::size_t>(index) >= input_->size()) {
-        PCL_ERROR("[dynvo::%s::align] index %d is outside the %zu-point source cloud.\n", name,
-                  static_cast<int>(index), input_->size());
+        PCL_ERROR(
+            "[dynvo::%s::align] index %d is outside the %zu-point source cloud.\n",
+            name, static_cast<int>(index), input_->size());
         return false;
       }
     }
@@ -111,8 +112,8 @@ StaticSceneRegistration<PointT>::collectCorrespondences()
     const PointFlow& f = (*flow_)[i];
     const Eigen::Vector3d b(f.x, f.y, f.z);
     const Eigen::Vector3d a(f.prev_x, f.prev_y, f.prev_z);
-    if (!static_cells_[i] || !f.valid_3d || !(f.weight > 0.0f) || !std::isfinite(f.weight) ||
-        !b.allFinite() || !a.allFinite())
+    if (!static_cells_[i] || !f.valid_3d || !(f.weight > 0.0f) ||
+        !std::isfinite(f.weight) || !b.allFinite() || !a.allFinite())
       continue;
     source_points_.push_back(b);
     target_points_.push_back(a);
@@ -128,8 +129,8 @@ StaticSceneRegistration<PointT>::estimateFromFlow()
   const auto min_count = static_cast<std::size_t>(params_.min_correspondences);
   if (count < min_count) {
     status_ = Status::too_few_correspondences;
-    PCL_DEBUG("[dynvo::%s::align] %zu static cells, fewer than %zu.\n", reg_name_.c_str(),
-              count, min_count);
+    PCL_DEBUG("[dynvo::%s::align] %zu static cells, fewer than %zu.\n",
+              reg_name_.c_str(), count, min_count);
     return false;
   }
   RigidFitAccumulator fit;
@@ -138,8 +139,8 @@ StaticSceneRegistration<PointT>::estimateFromFlow()
   Eigen::Matrix4d T_prev_curr;
   if (fit.solve(T_prev_curr) != RigidFitStatus::ok) {
     status_ = Status::degenerate;
-    PCL_DEBUG("[dynvo::%s::align] the %zu static cells are collinear.\n", reg_name_.c_str(),
-              count);
+    PCL_DEBUG("[dynvo::%s::align] the %zu static cells are collinear.\n",
+              reg_name_.c_str(), count);
     return false;
   }
   inliers_.assign(count, 1);
@@ -151,8 +152,8 @@ StaticSceneRegistration<PointT>::estimateFromFlow()
   for (int round = 0; round < params_.trim_rounds; ++round) {
     fit.clear();
     for (std::size_t i = 0; i < count; ++i) {
-      kept[i] = squaredTransferError(T_prev_curr, source_points_[i], target_points_[i]) <=
-                trim_threshold;
+      kept[i] = squaredTransferError(T_prev_curr, source_points_[i],
+                                     target_points_[i]) <= trim_threshold;
       if (kept[i])
         fit.add(source_points_[i], target_points_[i], weights_[i]);
     }
@@ -188,17 +189,19 @@ StaticSceneRegistration<PointT>::refine(Matrix4& refined) const
   }
   const auto min_count = static_cast<std::size_t>(params_.min_correspondences);
   if (source->size() < min_count || target->size() < min_count) {
-    PCL_DEBUG("[dynvo::%s::align] %zu source / %zu target points on the refinement lattice.\n",
+    PCL_DEBUG("[dynvo::%s::align] %zu source / %zu target points on the refinement "
+              "lattice.\n",
               reg_name_.c_str(), source->size(), target->size());
     return false;
   }
-  return detail::refineRigidTransformation(
-      source, target, params_.refinement, params_, flow_transformation_, refined);
+  return detail::refineRigidTransformation(source, target, params_.refinement, params_,
+                                           flow_transformation_, refined);
 }
 
 template <typename PointT>
 void
-StaticSceneRegistration<PointT>::computeTransformation(PointCloud& output, const Matrix4& guess)
+StaticSceneRegistration<PointT>::computeTransformation(PointCloud& output,
+                                                       const Matrix4& guess)
 {
   resetResults(guess);
   // Repeated here for calls through a pcl::Registration reference, which bypass align().
@@ -226,7 +229,8 @@ StaticSceneRegistration<PointT>::computeTransformation(PointCloud& output, const
   double residual_sum = 0.0;
   for (std::size_t i = 0; i < source_points_.size(); ++i)
     if (inliers_[i])
-      residual_sum += squaredTransferError(T_final, source_points_[i], target_points_[i]);
+      residual_sum +=
+          squaredTransferError(T_final, source_points_[i], target_points_[i]);
   fitness_ = residual_sum / static_cast<double>(inlier_count_);
   pcl::transformPointCloud(output, output, final_transformation_);
 }
