@@ -126,16 +126,24 @@ struct OdometryPipeline::Impl {
     registration.setInputSource(cloud);
     registration.setInputTarget(previous);
     registration.setInputFlow(flow);
-    // Static support: the segmentation's background gives a first estimate (or, when it
-    // fails, the constant-velocity prediction stands in); then every valid cell that moves
-    // like it counts as static, so background cells the noisy segmentation split off are
-    // used again while moving objects stay out.
+    // Static support: the segmentation's background gives a first estimate; then every
+    // valid cell that moves like it counts as static, so background cells the noisy
+    // segmentation split off are used again while moving objects stay out. Motion guard:
+    // when that estimate is missing or departs from the constant-velocity prediction by more
+    // than tau_cv (a moving object took the background label for a frame), the cells that
+    // agree with the prediction are the static support instead.
     const Eigen::Matrix4d T_prev_curr_predicted = inverse(T_curr_prev_predicted);
-    Eigen::Matrix4d T_prev_curr = T_prev_curr_predicted;
-    if (align(static_indices, T_prev_curr_predicted))
-      T_prev_curr = registration.getFinalTransformation().cast<double>();
-    if (options.use_segmentation && options.static_consensus > 0.0f)
-      align(consensusCells(*flow, cloud->width, T_prev_curr), T_prev_curr);
+    const bool background_fit = align(static_indices, T_prev_curr_predicted);
+    Eigen::Matrix4d T_prev_curr = registration.getFinalTransformation().cast<double>();
+    const double departure =
+        (T_curr_prev_predicted * T_prev_curr).topRightCorner<3, 1>().norm();
+    if (options.use_segmentation && options.static_consensus > 0.0f) {
+      const bool trusted =
+          background_fit && departure <= options.segmentation.static_guard_tolerance;
+      if (!trusted)
+        T_prev_curr = T_prev_curr_predicted;
+      align(consensusCells(*flow, *cloud, T_prev_curr, trusted), T_prev_curr);
+    }
     result.lost = !registration.hasConverged();
     result.T_curr_prev =
         result.lost ? T_curr_prev_predicted
@@ -154,20 +162,28 @@ struct OdometryPipeline::Impl {
   }
 
   /// Centre pixels of the valid cells whose flow agrees with T_prev_curr within
-  /// static_consensus * th_inlier (squared transfer error of b_i onto a_i).
+  /// static_consensus * th_inlier (squared transfer error of b_i onto a_i), leaving out the
+  /// moving-object segments when the labels are trusted (slow objects pass the test).
   pcl::IndicesPtr consensusCells(const pcl::PointCloud<PointFlow>& flow,
-                                 std::uint32_t image_width,
-                                 const Eigen::Matrix4d& T_prev_curr) const
+                                 const Cloud& cloud,
+                                 const Eigen::Matrix4d& T_prev_curr,
+                                 bool exclude_objects) const
   {
+    std::vector<bool> moving(cloud.size(), false);
+    for (std::size_t s = 1; exclude_objects && s < result.segments.size(); ++s)
+      for (const auto index : result.segments[s].indices)
+        moving[index] = true;
     const double limit = options.static_consensus * options.registration.th_inlier;
     auto indices = pcl::make_shared<pcl::Indices>();
-    for (const PointFlow& cell : flow)
-      if (cell.valid_3d &&
+    for (const PointFlow& cell : flow) {
+      const int index = static_cast<int>(cell.v) * static_cast<int>(cloud.width) +
+                        static_cast<int>(cell.u);
+      if (cell.valid_3d && !moving[index] &&
           squaredTransferError(
               T_prev_curr, cell.getVector3fMap().cast<double>(),
               Eigen::Vector3d(cell.prev_x, cell.prev_y, cell.prev_z)) <= limit)
-        indices->push_back(static_cast<int>(cell.v) * static_cast<int>(image_width) +
-                           static_cast<int>(cell.u));
+        indices->push_back(index);
+    }
     return indices;
   }
 

@@ -36,8 +36,10 @@ struct DYNVO_EXPORTS PipelineOptions {
   bool use_segmentation =
       true; ///< false: ablation, every valid flow cell counts as static
   /// Static support (multiple of registration.th_inlier, 0 = off): after a first fit on the
-  /// background segment, every valid cell whose flow agrees with it within this many
-  /// th_inlier (4: 11 mm) joins the static set for the final fit.
+  /// background segment, every valid cell outside the moving objects whose flow agrees with it
+  /// within this many th_inlier (4: 11 mm) joins the static set for the final fit. When that
+  /// first fit departs from the constant-velocity prediction by more than the segmentation's
+  /// static_guard_tolerance (tau_cv), the cells agreeing with the prediction are used instead.
   float static_consensus = 4.0f;
   unsigned threads = 1; ///< worker threads; results do not depend on it
 
