@@ -10,6 +10,7 @@
 #include <dynvo/io/trajectory_io.h>
 
 #ifdef DYNVO_WITH_VTK
+#include <dynvo/vis/display.h>
 #include <dynvo/vis/label_renderer.h>
 #include <dynvo/vis/trajectory_plot.h>
 #endif
@@ -134,7 +135,8 @@ public:
   void finish(const dynvo::Trajectory& estimate, const dynvo::Trajectory& groundtruth)
   {
 #ifdef DYNVO_WITH_VTK
-    if (dir_.empty() || estimate.size() < 2)
+    // Without a display the renderer has already said so once.
+    if (dir_.empty() || estimate.size() < 2 || !dynvo::displayAvailable())
       return;
     const std::string plot = (fs::path(dir_) / "trajectory.png").string();
     const auto aligned = groundtruth.empty()
