@@ -123,8 +123,7 @@ public:
     params_.width = frame.cloud->width;
     params_.height = frame.cloud->height;
     renderer_.setParameters(params_);
-    const std::string name =
-        fs::path(dynvo::labelFileName(frame.timestamp)).stem().string();
+    const std::string name = dynvo::formatStamp(frame.timestamp);
     renderer_.render(*frame.cloud, result.labels, trajectory.back().T_world_camera,
                      trajectory, (fs::path(dir_) / (name + "_camera.png")).string());
 #else

@@ -190,8 +190,7 @@ main(int argc, char** argv)
     for (long index = 0; source->next(frame); ++index) {
       if (frames.empty() ? index % every != 0 : frames.count(index) == 0)
         continue;
-      const std::string stamp =
-          fs::path(dynvo::labelFileName(frame.timestamp)).stem().string();
+      const std::string stamp = dynvo::formatStamp(frame.timestamp);
       const std::size_t k =
           estimate.empty() ? 0 : dynvo::findClosestIndex(stamps, frame.timestamp);
       const auto labels =

@@ -105,7 +105,7 @@ main(int argc, char** argv)
       flow_estimation.shiftCurrentToPrevious();
       flow_estimation.setInputCloud(frame.cloud);
       const std::string path =
-          (out_dir / dynvo::labelFileName(frame.timestamp)).string();
+          (out_dir / dynvo::stampedPngName(frame.timestamp)).string();
       if (count == 0) {
         dynvo::writeLabelImage(path, dynvo::paintLabelImage({}, {}, frame.cloud->width,
                                                             frame.cloud->height));

@@ -65,7 +65,7 @@ TEST_F(OdometryApp, WritesTrajectoryLabelsObjectsAndClosingLines)
   }
   EXPECT_EQ(images, static_cast<std::size_t>(FRAMES));
   EXPECT_TRUE(fs::exists(out_.file("labels") + "/" +
-                         dynvo::labelFileName(trajectory[3].timestamp)));
+                         dynvo::stampedPngName(trajectory[3].timestamp)));
   EXPECT_TRUE(fs::exists(out_.file("o.txt")));
   EXPECT_FALSE(fs::exists(out_.file("o.txt.partial")));
   // The folder has a ground truth, so the evaluate line comes before the summary line.

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include "support/rigid_motion.h"
+
 #include <Eigen/Geometry>
 
 #include <cmath>
@@ -12,18 +14,6 @@
 #include <vector>
 
 namespace {
-
-Eigen::Matrix4d
-makeTransform(const Eigen::Vector3d& axis,
-              double angle,
-              const Eigen::Vector3d& translation)
-{
-  Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
-  T.topLeftCorner<3, 3>() =
-      Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
-  T.topRightCorner<3, 1>() = translation;
-  return T;
-}
 
 Eigen::Vector3d
 apply(const Eigen::Matrix4d& T, const Eigen::Vector3d& p)
@@ -58,9 +48,9 @@ TEST(RigidFitAccumulator, RecoversRandomMotionsFromExactPairs)
   std::uniform_real_distribution<double> coord(-2.0, 2.0), weight(0.1, 1.0),
       angle(-1.5, 1.5);
   for (int trial = 0; trial < 20; ++trial) {
-    const Eigen::Matrix4d T =
-        makeTransform(Eigen::Vector3d(coord(rng), coord(rng), coord(rng)), angle(rng),
-                      Eigen::Vector3d(coord(rng), coord(rng), coord(rng)));
+    const Eigen::Matrix4d T = dynvo::test::makeMotion(
+        Eigen::Vector3d(coord(rng), coord(rng), coord(rng)), angle(rng),
+        Eigen::Vector3d(coord(rng), coord(rng), coord(rng)));
     dynvo::RigidFitAccumulator fit;
     for (int i = 0; i < 30; ++i) {
       const Eigen::Vector3d s(coord(rng), coord(rng), coord(rng) + 3.0);
@@ -81,9 +71,9 @@ TEST(RigidFitAccumulator, WeightsDecideBetweenTwoMotions)
   // Two interleaved rigid motions: the fit follows the heavily weighted one, and pairs of
   // weight 0 are ignored exactly.
   const Eigen::Matrix4d A =
-      makeTransform(Eigen::Vector3d::UnitY(), 0.1, {0.05, 0.0, 0.0});
+      dynvo::test::makeMotion(Eigen::Vector3d::UnitY(), 0.1, {0.05, 0.0, 0.0});
   const Eigen::Matrix4d B =
-      makeTransform(Eigen::Vector3d::UnitX(), -0.3, {0.0, 0.2, 0.1});
+      dynvo::test::makeMotion(Eigen::Vector3d::UnitX(), -0.3, {0.0, 0.2, 0.1});
   dynvo::RigidFitAccumulator fit;
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> coord(-1.0, 1.0);
@@ -106,7 +96,7 @@ TEST(RigidFitAccumulator, PlanarPointsGiveAProperRotation)
   // A plane (z = 2) rotated by 180 degrees about its normal: without the reflection guard the
   // SVD of a rank-2 cross-covariance can return a mirror (det = -1).
   const Eigen::Matrix4d T =
-      makeTransform(Eigen::Vector3d::UnitZ(), 3.0, {0.1, -0.2, 0.3});
+      dynvo::test::makeMotion(Eigen::Vector3d::UnitZ(), 3.0, {0.1, -0.2, 0.3});
   dynvo::RigidFitAccumulator fit;
   for (int i = 0; i < 5; ++i)
     for (int j = 0; j < 5; ++j) {
@@ -130,9 +120,9 @@ TEST(RigidFitAccumulator, PointsFarFromTheOriginKeepTheirPrecision)
   // origin keeps the error at round-off of the offsets (~1e-12 m), so 1e-7 rad / 1e-9 m hold.
   const Eigen::Vector3d far(1e4, -1e4, 1e4);
   const Eigen::Matrix4d T =
-      makeTransform(Eigen::Vector3d(1, 2, 3), 0.2, {0.001, 0.002, 0.0});
+      dynvo::test::makeMotion(Eigen::Vector3d(1, 2, 3), 0.2, {0.001, 0.002, 0.0});
   const Eigen::Matrix4d T_centred =
-      makeTransform(Eigen::Vector3d(1, 2, 3), 0.2, Eigen::Vector3d::Zero());
+      dynvo::test::makeMotion(Eigen::Vector3d(1, 2, 3), 0.2, Eigen::Vector3d::Zero());
   dynvo::RigidFitAccumulator fit;
   const double mm = 1e-3;
   const Eigen::Vector3d offsets[] = {
@@ -193,7 +183,7 @@ TEST(RigidFitAccumulator, RejectsNonFiniteInputAndNegativeWeights)
 TEST(RigidFitAccumulator, SquaredTransferErrorIsTheResidualOfEquationOne)
 {
   const Eigen::Matrix4d T =
-      makeTransform(Eigen::Vector3d::UnitZ(), M_PI / 2, {1.0, 0.0, 0.0});
+      dynvo::test::makeMotion(Eigen::Vector3d::UnitZ(), M_PI / 2, {1.0, 0.0, 0.0});
   // R (1,0,0) + t = (0,1,0) + (1,0,0) = (1,1,0); the target is 3 cm away along z.
   EXPECT_NEAR(dynvo::squaredTransferError(T, {1, 0, 0}, {1, 1, 0.03}), 9e-4, 1e-15);
 }

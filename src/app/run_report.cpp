@@ -75,7 +75,7 @@ RunOutputs::add(const FrameResult& result)
   trajectory_.push_back(pose);
 
   if (!labels_dir_.empty())
-    writeLabelImage((fs::path(labels_dir_) / labelFileName(result.timestamp)).string(),
+    writeLabelImage((fs::path(labels_dir_) / stampedPngName(result.timestamp)).string(),
                     {result.width, result.height, result.labels});
   if (objects_.is_open()) {
     for (std::size_t s = 1; s < result.segments.size(); ++s)

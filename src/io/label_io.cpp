@@ -27,11 +27,17 @@ paintLabelImage(const std::vector<pcl::PointIndices>& segments,
 }
 
 std::string
-labelFileName(double timestamp)
+formatStamp(double timestamp)
 {
-  char name[64];
-  std::snprintf(name, sizeof(name), "%.6f.png", timestamp);
-  return name;
+  char text[64];
+  std::snprintf(text, sizeof(text), "%.6f", timestamp);
+  return text;
+}
+
+std::string
+stampedPngName(double timestamp)
+{
+  return formatStamp(timestamp) + ".png";
 }
 
 void

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // SceneSynthesizer::writeSequence: the TUM folder layout, frames written in parallel.
+#include <dynvo/io/label_io.h>
 #include <dynvo/io/trajectory_io.h>
 #include <dynvo/synth/scene_synthesizer.h>
 
@@ -28,14 +29,6 @@ namespace {
 
 /// zlib level 1: the textures are incompressible noise, so higher levels buy little.
 constexpr int PNG_COMPRESSION = 1;
-
-std::string
-stampName(double stamp)
-{
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), "%.6f", stamp);
-  return buffer;
-}
 
 void
 writePng(const fs::path& path, const cv::Mat& image)
@@ -72,12 +65,10 @@ writeFrame(const fs::path& root, const SynthFrame& frame)
                                    std::round(z * SceneSynthesizer::DEPTH_PNG_SCALE));
     }
   }
-  const cv::Mat labels(height, width, CV_8UC1,
-                       const_cast<std::uint8_t*>(frame.labels.data()));
-  const std::string colour_name = stampName(frame.timestamp) + ".png";
-  writePng(root / "rgb" / colour_name, bgr);
-  writePng(root / "depth" / (stampName(frame.depth_timestamp) + ".png"), depth);
-  writePng(root / "labels" / colour_name, labels);
+  writePng(root / "rgb" / stampedPngName(frame.timestamp), bgr);
+  writePng(root / "depth" / stampedPngName(frame.depth_timestamp), depth);
+  writeLabelImage((root / "labels" / stampedPngName(frame.timestamp)).string(),
+                  {frame.color.width, frame.color.height, frame.labels});
 }
 
 /// Refuses anything but a missing or empty folder, then creates the layout's folders.
@@ -171,8 +162,8 @@ SceneSynthesizer::writeSequence(const std::string& folder, int threads) const
   Trajectory trajectory;
   for (int k = 0; k < frames; ++k) {
     const FrameScript script = impl_->script(k);
-    const std::string colour = stampName(script.timestamp);
-    const std::string depth_stamp = stampName(script.depth_timestamp);
+    const std::string colour = formatStamp(script.timestamp);
+    const std::string depth_stamp = formatStamp(script.depth_timestamp);
     rgb << colour << " rgb/" << colour << ".png\n";
     depth << depth_stamp << " depth/" << depth_stamp << ".png\n";
     trajectory.push_back({script.timestamp, script.T_world_camera});

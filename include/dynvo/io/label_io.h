@@ -29,8 +29,11 @@ DYNVO_EXPORTS LabelImage paintLabelImage(const std::vector<pcl::PointIndices>& s
                                          std::uint32_t width,
                                          std::uint32_t height);
 
-/// File name of a frame's label image: "<timestamp %.6f>.png".
-DYNVO_EXPORTS std::string labelFileName(double timestamp);
+/// A timestamp as written in file names and index files: "%.6f" (seconds).
+DYNVO_EXPORTS std::string formatStamp(double timestamp);
+
+/// File name of a frame's images (colour, depth, labels): "<timestamp %.6f>.png".
+DYNVO_EXPORTS std::string stampedPngName(double timestamp);
 
 /// Writes an 8-bit single-channel PNG. \throws pcl::IOException naming the file on failure
 DYNVO_EXPORTS void writeLabelImage(const std::string& path, const LabelImage& labels);

@@ -5,6 +5,8 @@
 #include <dynvo/common/camera.h>
 #include <dynvo/common/point_types.h>
 
+#include "support/rigid_motion.h"
+
 #include <pcl/point_cloud.h>
 
 #include <Eigen/Geometry>
@@ -16,19 +18,6 @@
 #include <vector>
 
 namespace dynvo::test {
-
-/// Rigid motion from an axis-angle rotation (radians) and a translation (metres).
-inline Eigen::Matrix4d
-makeMotion(const Eigen::Vector3d& axis,
-           double angle,
-           const Eigen::Vector3d& translation)
-{
-  Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
-  T.topLeftCorner<3, 3>() =
-      Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
-  T.topRightCorner<3, 1>() = translation;
-  return T;
-}
 
 /// Rotation angle (degrees) of T_a^-1 T_b.
 inline double
