@@ -59,6 +59,7 @@ allValidCells(const pcl::PointCloud<PointFlow>& flow, std::uint32_t image_width)
 
 PipelineOptions::PipelineOptions()
 {
+  scene_flow.depth_window_radius = 6;
   segmentation.inlier_threshold = 6e-5f;
 }
 

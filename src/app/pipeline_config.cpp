@@ -34,6 +34,7 @@ visitFields(Options& o, Visit&& visit)
   visit("scene_flow", "forward_backward_threshold", f.forward_backward_threshold);
   visit("scene_flow", "depth_edge_tolerance", f.depth_edge_tolerance);
   visit("scene_flow", "max_flow", f.max_flow);
+  visit("scene_flow", "depth_window_radius", f.depth_window_radius);
   visit("scene_flow", "weight_reference_depth", f.weight_reference_depth);
   auto& s = o.segmentation;
   visit("segmentation", "cell_size", s.cell_size);

@@ -44,6 +44,9 @@ GridSceneFlowParameters::validate() const
   if (!(depth_edge_tolerance >= 0.0f && std::isfinite(depth_edge_tolerance)))
     fail("depth_edge_tolerance must be finite and >= 0, got " +
          std::to_string(depth_edge_tolerance));
+  if (depth_window_radius < 0 || depth_window_radius > 15)
+    fail("depth_window_radius must be in [0, 15] px, got " +
+         std::to_string(depth_window_radius));
   if (!(max_flow > 0.0f && std::isfinite(max_flow)))
     fail("max_flow must be > 0 m, got " + std::to_string(max_flow));
   if (!(weight_reference_depth > 0.0f && std::isfinite(weight_reference_depth)))
@@ -104,6 +107,65 @@ trackedDepth(const std::vector<float>& depth, int width, cv::Point2f p, float ta
   // Nearest of the four pixels: it may be valid even when the window straddles an edge.
   const float* row = fy < 0.5f ? row0 : row1;
   return row[fx < 0.5f ? 0 : 1];
+}
+
+/// Sampling step of the depth window (px): every other row and column, so the window spans
+/// twice the pixels for the same cost.
+constexpr int WINDOW_STEP = 2;
+
+/** Depth at the sub-pixel point p from the plane 1/z = c0 + c1 dx + c2 dy (dx, dy: offsets
+ * from p) fitted to the pixels of the (2r + 1)^2 window around p whose depth is within
+ * tau_edge of z_point, the single-pixel depth; z_point stands when fewer than half the
+ * window agrees. The normal equations are accumulated in double and solved by Cramer's rule.
+ */
+float
+windowDepth(const std::vector<float>& depth,
+            int width,
+            int height,
+            cv::Point2f p,
+            float z_point,
+            int radius,
+            float tau_edge)
+{
+  const int u0 = static_cast<int>(std::lround(p.x));
+  const int v0 = static_cast<int>(std::lround(p.y));
+  const float tolerance = tau_edge * z_point;
+  double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0, sw = 0, swx = 0, swy = 0;
+  for (int v = v0 - radius; v <= v0 + radius; v += WINDOW_STEP) {
+    if (v < 0 || v >= height)
+      continue;
+    const float* row = depth.data() + static_cast<std::size_t>(v) * width;
+    const double dy = v - p.y;
+    for (int u = u0 - radius; u <= u0 + radius; u += WINDOW_STEP) {
+      if (u < 0 || u >= width)
+        continue;
+      const float z = row[u];
+      if (!(std::abs(z - z_point) <= tolerance))
+        continue;
+      const double dx = u - p.x;
+      const double w = 1.0 / z;
+      n += 1.0;
+      sx += dx;
+      sy += dy;
+      sxx += dx * dx;
+      sxy += dx * dy;
+      syy += dy * dy;
+      sw += w;
+      swx += w * dx;
+      swy += w * dy;
+    }
+  }
+  const int side = 2 * (radius / WINDOW_STEP) + 1;
+  if (2.0 * n < side * side)
+    return z_point;
+  // c0 of [n sx sy; sx sxx sxy; sy sxy syy] c = [sw swx swy].
+  const double det = n * (sxx * syy - sxy * sxy) - sx * (sx * syy - sxy * sy) +
+                     sy * (sx * sxy - sxx * sy);
+  const double det0 = sw * (sxx * syy - sxy * sxy) - sx * (swx * syy - sxy * swy) +
+                      sy * (swx * sxy - sxx * swy);
+  const double inverse_depth = det0 / det;
+  return det > 0.0 && inverse_depth > 0.0 ? static_cast<float>(1.0 / inverse_depth)
+                                          : z_point;
 }
 
 } // namespace
@@ -246,8 +308,12 @@ GridFlowEngine::compute(const GridSceneFlowParameters& params,
     f.valid_2d = valid2d[i];
     f.prev_u = f.valid_2d ? p.x : NaN;
     f.prev_v = f.valid_2d ? p.y : NaN;
-    const float z_b = centreDepth(curr.depth, width, height, static_cast<int>(c.x),
-                                  static_cast<int>(c.y));
+    const int r = params.depth_window_radius;
+    float z_b = centreDepth(curr.depth, width, height, static_cast<int>(c.x),
+                            static_cast<int>(c.y));
+    if (r > 0 && !std::isnan(z_b))
+      z_b = windowDepth(curr.depth, width, height, c, z_b, r,
+                        params.depth_edge_tolerance);
     f.getVector3fMap() = std::isnan(z_b) ? Eigen::Vector3f::Constant(NaN)
                                          : intrinsics.backproject(c.x, c.y, z_b);
     f.prev_x = f.prev_y = f.prev_z = NaN;
@@ -255,9 +321,12 @@ GridFlowEngine::compute(const GridSceneFlowParameters& params,
     f.valid_3d = 0;
     if (!f.valid_2d || std::isnan(z_b))
       continue;
-    const float z_a = trackedDepth(prev.depth, width, p, params.depth_edge_tolerance);
+    float z_a = trackedDepth(prev.depth, width, p, params.depth_edge_tolerance);
     if (std::isnan(z_a))
       continue;
+    if (r > 0)
+      z_a = windowDepth(prev.depth, width, height, p, z_a, r,
+                        params.depth_edge_tolerance);
     const Eigen::Vector3f a = intrinsics.backproject(p.x, p.y, z_a);
     if ((f.getVector3fMap() - a).squaredNorm() > max_flow2)
       continue;

@@ -45,6 +45,12 @@ struct DYNVO_EXPORTS GridSceneFlowParameters {
   float forward_backward_threshold = 1.0f;
   /// tau_edge (relative, >= 0): bilinear depth needs (max - min) <= tau_edge * min.
   float depth_edge_tolerance = 0.05f;
+  /// Depth window radius r (px, 0..15): with r > 0 the depths of a_i and b_i come from a
+  /// plane fitted in inverse depth (exact for planar surfaces) to every other pixel of the
+  /// (2r + 1)^2 window around the point whose depth is within tau_edge of the single-pixel
+  /// value, evaluated at the point. This averages out most of the sensor's per-pixel noise
+  /// and disparity quantisation; 0 = ALGORITHM.md §1.2's single pixel.
+  int depth_window_radius = 0;
   /// max_flow3d (metres per frame, > 0): a larger |b - a| is a gross error.
   float max_flow = 0.5f;
   /// z_ref (metres, > 0): weight = min(1, (z_ref / z)^4), the inverse of the depth-noise
