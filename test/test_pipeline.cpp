@@ -70,12 +70,13 @@ TEST(OdometryPipeline, FollowsAMovingCameraPastAMovingObject)
   const SequenceRun run = runScenario("moving_crossing", 45);
   for (std::size_t k = 0; k < run.lost.size(); ++k)
     EXPECT_FALSE(run.lost[k]) << "frame " << k;
-  // 1.5 s of Kinect-like noisy depth at 1-2.2 m (about 3-6 mm per depth): the paper reaches
-  // 0.027 m/s RPE on the real fr1/xyz (and the issue asks 0.03 there); the box entering the
-  // view must not push the estimate beyond that (measured 0.023 m/s).
+  // 1.5 s of Kinect-like noisy depth at 1-2.2 m (about 1-6 mm per pixel, under 1 mm after the
+  // depth window): the issue's bound on the synthetic scenes is 0.02 m/s, and the box
+  // entering the view must not push the estimate beyond a seventh of it (measured 0.0017 m/s,
+  // 0.06 deg/s).
   const auto rpe = dynvo::computeRpe(run.groundtruth, run.estimate);
-  EXPECT_LT(rpe.trans_rmse, 0.03);
-  EXPECT_LT(rpe.rot_rmse, 1.0);
+  EXPECT_LT(rpe.trans_rmse, 0.003);
+  EXPECT_LT(rpe.rot_rmse, 0.2);
 }
 
 TEST(OdometryPipeline, StaticCameraIsNotFooledByMovingBoxes)
@@ -86,10 +87,10 @@ TEST(OdometryPipeline, StaticCameraIsNotFooledByMovingBoxes)
   const auto rpe = dynvo::computeRpe(run.groundtruth, run.estimate);
   const auto ablation_rpe = dynvo::computeRpe(ablation.groundtruth, ablation.estimate);
   // The camera stands still while two boxes (about 15 % of the cells) move 1-3 cm per
-  // frame. With the boxes kept out, only depth noise remains (same 0.03 m/s bound as above);
-  // counting every cell as static drags the estimate along with the boxes, several times
-  // further (measured about 0.017 against 0.18 m/s over these 2 s).
-  EXPECT_LT(rpe.trans_rmse, 0.03);
+  // frame. With the boxes kept out, only depth noise remains (the issue's 0.02 m/s bound);
+  // counting every cell as static drags the estimate along with the boxes, many times
+  // further (measured 0.0072 against 0.13 m/s over these 2 s).
+  EXPECT_LT(rpe.trans_rmse, 0.02);
   EXPECT_GT(ablation_rpe.trans_rmse, 3.0 * rpe.trans_rmse);
 }
 

@@ -168,6 +168,11 @@ public:
     updateField(&Parameters::depth_edge_tolerance, ratio);
   }
   float getDepthEdgeTolerance() const { return params_.depth_edge_tolerance; }
+  void setDepthWindowRadius(int pixels)
+  {
+    updateField(&Parameters::depth_window_radius, pixels);
+  }
+  int getDepthWindowRadius() const { return params_.depth_window_radius; }
   void setMaxFlow(float metres) { updateField(&Parameters::max_flow, metres); }
   float getMaxFlow() const { return params_.max_flow; }
   void setWeightReferenceDepth(float metres)
