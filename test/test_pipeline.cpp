@@ -145,4 +145,14 @@ TEST(OdometryPipeline, RejectsFramesThatChangeSizeOrAreNotOrganized)
   EXPECT_THROW(dynvo::app::OdometryPipeline{options}, std::invalid_argument);
 }
 
+TEST(OdometryPipeline, NoiseFollowingThresholdBoundsAreValidated)
+{
+  dynvo::app::PipelineOptions options;
+  options.min_inlier_threshold = 2.0f * options.segmentation.inlier_threshold;
+  EXPECT_THROW(dynvo::app::OdometryPipeline{options}, std::invalid_argument);
+  options.min_inlier_threshold = 3e-5f;
+  options.inlier_noise_factor = -1.0f;
+  EXPECT_THROW(dynvo::app::OdometryPipeline{options}, std::invalid_argument);
+}
+
 } // namespace

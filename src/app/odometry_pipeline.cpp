@@ -8,6 +8,7 @@
 
 #include <Eigen/SVD>
 
+#include <algorithm>
 #include <chrono>
 #include <stdexcept>
 
@@ -73,6 +74,12 @@ PipelineOptions::validate() const
   if (threads == 0)
     throw std::invalid_argument(
         "[dynvo::app::PipelineOptions] threads must be at least 1");
+  if (!(inlier_noise_factor >= 0.0f) ||
+      !(min_inlier_threshold > 0.0f &&
+        min_inlier_threshold <= segmentation.inlier_threshold))
+    throw std::invalid_argument(
+        "[dynvo::app::PipelineOptions] inlier_noise_factor must be >= 0 and "
+        "min_inlier_threshold in (0, segmentation.inlier_threshold]");
   if (!(static_consensus >= 0.0f))
     throw std::invalid_argument(
         "[dynvo::app::PipelineOptions] static_consensus must be >= 0");
@@ -109,6 +116,11 @@ struct OdometryPipeline::Impl {
     const auto segmentation_start = Clock::now();
     pcl::IndicesPtr static_indices;
     if (options.use_segmentation) {
+      if (options.inlier_noise_factor > 0.0f && residual_mean > 0.0)
+        segmentation.setInlierThreshold(static_cast<float>(
+            std::clamp(options.inlier_noise_factor * residual_mean,
+                       static_cast<double>(options.min_inlier_threshold),
+                       static_cast<double>(options.segmentation.inlier_threshold))));
       segmentation.setInputCloud(cloud);
       segmentation.setInputFlow(flow);
       segmentation.setPredictedMotion(T_curr_prev_predicted.cast<float>());
@@ -146,6 +158,10 @@ struct OdometryPipeline::Impl {
       align(consensusCells(*flow, *cloud, T_prev_curr, trusted), T_prev_curr);
     }
     result.lost = !registration.hasConverged();
+    if (!result.lost)
+      residual_mean = residual_mean > 0.0
+                          ? 0.9 * residual_mean + 0.1 * registration.getFitnessScore()
+                          : registration.getFitnessScore();
     result.T_curr_prev =
         result.lost ? T_curr_prev_predicted
                     : inverse(registration.getFinalTransformation().cast<double>());
@@ -195,6 +211,8 @@ struct OdometryPipeline::Impl {
   Cloud::ConstPtr previous;
   Eigen::Matrix4d T_world_prev = Eigen::Matrix4d::Identity();
   Eigen::Matrix4d T_curr_prev_predicted = Eigen::Matrix4d::Identity();
+  double residual_mean =
+      0.0; ///< running mean of the static fit's residual (m^2), 0 = none
   std::size_t frames = 0;
   FrameResult result;
 };

@@ -73,6 +73,8 @@ visitFields(Options& o, Visit&& visit)
   visit("registration", "refinement_stride", r.refinement_stride);
   visit("pipeline", "use_segmentation", o.use_segmentation);
   visit("pipeline", "static_consensus", o.static_consensus);
+  visit("pipeline", "inlier_noise_factor", o.inlier_noise_factor);
+  visit("pipeline", "min_inlier_threshold", o.min_inlier_threshold);
   visit("pipeline", "threads", o.threads);
 }
 
