@@ -117,10 +117,11 @@ struct OdometryPipeline::Impl {
     pcl::IndicesPtr static_indices;
     if (options.use_segmentation) {
       if (options.inlier_noise_factor > 0.0f && residual_mean > 0.0)
-        segmentation.setInlierThreshold(static_cast<float>(
+        inlier_threshold =
             std::clamp(options.inlier_noise_factor * residual_mean,
                        static_cast<double>(options.min_inlier_threshold),
-                       static_cast<double>(options.segmentation.inlier_threshold))));
+                       static_cast<double>(options.segmentation.inlier_threshold));
+      segmentation.setInlierThreshold(static_cast<float>(inlier_threshold));
       segmentation.setInputCloud(cloud);
       segmentation.setInputFlow(flow);
       segmentation.setPredictedMotion(T_curr_prev_predicted.cast<float>());
@@ -143,19 +144,26 @@ struct OdometryPipeline::Impl {
     // valid cell that moves like it counts as static, so background cells the noisy
     // segmentation split off are used again while moving objects stay out. Motion guard:
     // when that estimate is missing or departs from the constant-velocity prediction by more
-    // than tau_cv (a moving object took the background label for a frame), the cells that
-    // agree with the prediction are the static support instead.
+    // than tau_cv (a moving object took the background label for a frame), the first
+    // estimate comes from the cells within tau_cv of the prediction instead.
     const Eigen::Matrix4d T_prev_curr_predicted = inverse(T_curr_prev_predicted);
     const bool background_fit = align(static_indices, T_prev_curr_predicted);
     Eigen::Matrix4d T_prev_curr = registration.getFinalTransformation().cast<double>();
     const double departure =
         (T_curr_prev_predicted * T_prev_curr).topRightCorner<3, 1>().norm();
     if (options.use_segmentation && options.static_consensus > 0.0f) {
-      const bool trusted =
-          background_fit && departure <= options.segmentation.static_guard_tolerance;
-      if (!trusted)
-        T_prev_curr = T_prev_curr_predicted;
-      align(consensusCells(*flow, *cloud, T_prev_curr, trusted), T_prev_curr);
+      const double tau = options.segmentation.static_guard_tolerance;
+      const bool trusted = background_fit && departure <= tau;
+      if (!trusted) {
+        align(consensusCells(*flow, *cloud, T_prev_curr_predicted, false, tau * tau),
+              T_prev_curr_predicted);
+        T_prev_curr = registration.hasConverged()
+                          ? registration.getFinalTransformation().cast<double>()
+                          : T_prev_curr_predicted;
+      }
+      align(consensusCells(*flow, *cloud, T_prev_curr, trusted,
+                           options.static_consensus * inlier_threshold),
+            T_prev_curr);
     }
     result.lost = !registration.hasConverged();
     if (!result.lost)
@@ -178,19 +186,19 @@ struct OdometryPipeline::Impl {
     return registration.hasConverged();
   }
 
-  /// Centre pixels of the valid cells whose flow agrees with T_prev_curr within
-  /// static_consensus * th_inlier (squared transfer error of b_i onto a_i), leaving out the
-  /// moving-object segments when the labels are trusted (slow objects pass the test).
+  /// Centre pixels of the valid cells whose flow agrees with T_prev_curr within `limit`
+  /// (squared transfer error of b_i onto a_i, m^2), leaving out the moving-object segments
+  /// when the labels are trusted (slow objects pass the test).
   pcl::IndicesPtr consensusCells(const pcl::PointCloud<PointFlow>& flow,
                                  const Cloud& cloud,
                                  const Eigen::Matrix4d& T_prev_curr,
-                                 bool exclude_objects) const
+                                 bool exclude_objects,
+                                 double limit) const
   {
     std::vector<bool> moving(cloud.size(), false);
     for (std::size_t s = 1; exclude_objects && s < result.segments.size(); ++s)
       for (const auto index : result.segments[s].indices)
         moving[index] = true;
-    const double limit = options.static_consensus * options.registration.th_inlier;
     auto indices = pcl::make_shared<pcl::Indices>();
     for (const PointFlow& cell : flow) {
       const int index = static_cast<int>(cell.v) * static_cast<int>(cloud.width) +
@@ -213,6 +221,8 @@ struct OdometryPipeline::Impl {
   Eigen::Matrix4d T_curr_prev_predicted = Eigen::Matrix4d::Identity();
   double residual_mean =
       0.0; ///< running mean of the static fit's residual (m^2), 0 = none
+  /// this frame's segmentation inlier threshold (m^2), noise-following
+  double inlier_threshold = options.segmentation.inlier_threshold;
   std::size_t frames = 0;
   FrameResult result;
 };
