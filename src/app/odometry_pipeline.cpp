@@ -187,27 +187,24 @@ struct OdometryPipeline::Impl {
   }
 
   /// Centre pixels of the valid cells whose flow agrees with T_prev_curr within `limit`
-  /// (squared transfer error of b_i onto a_i, m^2), leaving out the moving-object segments
-  /// when the labels are trusted (slow objects pass the test).
+  /// (squared transfer error of b_i onto a_i, m^2), leaving out the cells labelled as moving
+  /// objects when the labels are trusted (slow objects pass the test).
   pcl::IndicesPtr consensusCells(const pcl::PointCloud<PointFlow>& flow,
                                  const Cloud& cloud,
                                  const Eigen::Matrix4d& T_prev_curr,
                                  bool exclude_objects,
                                  double limit) const
   {
-    std::vector<bool> moving(cloud.size(), false);
-    for (std::size_t s = 1; exclude_objects && s < result.segments.size(); ++s)
-      for (const auto index : result.segments[s].indices)
-        moving[index] = true;
+    const std::vector<std::uint8_t>& labels = segmentation.getCellLabels();
     auto indices = pcl::make_shared<pcl::Indices>();
-    for (const PointFlow& cell : flow) {
-      const int index = static_cast<int>(cell.v) * static_cast<int>(cloud.width) +
-                        static_cast<int>(cell.u);
-      if (cell.valid_3d && !moving[index] &&
+    for (std::size_t i = 0; i < flow.size(); ++i) {
+      const PointFlow& cell = flow[i];
+      if (cell.valid_3d && !(exclude_objects && labels[i] > LABEL_STATIC) &&
           squaredTransferError(
               T_prev_curr, cell.getVector3fMap().cast<double>(),
               Eigen::Vector3d(cell.prev_x, cell.prev_y, cell.prev_z)) <= limit)
-        indices->push_back(index);
+        indices->push_back(static_cast<int>(cell.v) * static_cast<int>(cloud.width) +
+                           static_cast<int>(cell.u));
     }
     return indices;
   }

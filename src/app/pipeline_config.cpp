@@ -58,6 +58,7 @@ visitFields(Options& o, Visit&& visit)
   visit("segmentation", "min_correlation", s.min_correlation);
   visit("segmentation", "static_guard_tolerance", s.static_guard_tolerance);
   visit("segmentation", "static_min_cells", s.static_min_cells);
+  visit("segmentation", "object_separation_ratio", s.object_separation_ratio);
   visit("segmentation", "seed", s.seed);
   auto& r = o.registration;
   visit("registration", "th_inlier", r.th_inlier);

@@ -108,11 +108,13 @@ makeScenarios()
                     ellipse(V(1.2, 0.0, 0.0), V(0.0, 0.0, 0.2), 0.55, -HALF_PI),
                     0.5)}});
 
-  // The box travels along the mean optical axis from 1.8 m to 0.7 m (front face at
-  // about 0.35 m, covering most of the image) and back, every 10.5 s.
+  // The box travels along the mean optical axis from 2.0 m to 0.9 m and back, every 10.5 s.
+  // At its nearest it covers about 80 % of the image, and its front face comes to about
+  // 0.5 m, where the sensor loses it for some 20 frames; the background around it stays
+  // measured in every frame, so the camera's motion is always observable.
   ScriptedBox occluder{1, V(0.35, 0.35, 0.35), {}, {}};
   occluder.path.base_rotation = cameraBaseRotation();
-  occluder.path.centre = cameraBaseRotation() * V(0.05, 0.0, 1.25);
+  occluder.path.centre = cameraBaseRotation() * V(0.05, 0.0, 1.45);
   occluder.path.translation = {
       {cameraBaseRotation() * V(0.0, 0.0, 0.55), 0.6, HALF_PI}};
   occluder.path.rotation = {{V(0.1, 0.0, 0.0), 0.8, 0.0},

@@ -59,6 +59,9 @@ RigidMotionSegmentationParameters::validate() const
          std::to_string(static_guard_tolerance));
   if (static_min_cells < 1)
     fail("static_min_cells must be >= 1 cell, got " + std::to_string(static_min_cells));
+  if (!(std::isfinite(object_separation_ratio) && object_separation_ratio >= 0.0f))
+    fail("object_separation_ratio must be >= 0, got " +
+         std::to_string(object_separation_ratio));
 }
 
 } // namespace dynvo

@@ -72,6 +72,7 @@ SegmentTracker::reset()
   source_.clear();
   tracked_.clear();
   fused_.clear();
+  previous_fused_.clear();
   ids_.clear();
   motions_.clear();
 }
@@ -263,6 +264,84 @@ SegmentTracker::guardBackground(const GridFlowData& grid,
 }
 
 void
+SegmentTracker::keepObjectsApart(const GridFlowData& grid,
+                                 const SpatialSegmentationResult& spatial,
+                                 const std::vector<int>& ids,
+                                 const RigidMotionSegmentationParameters& params)
+{
+  const double ratio = params.object_separation_ratio;
+  if (ratio <= 0.0 || previous_fused_.size() != grid.size())
+    return;
+  const std::vector<std::uint8_t> previous = warpNearest(previous_fused_, grid);
+  const int g = spatial.segmentCount();
+  const int labels = params.max_labels;
+  std::vector<int> segment_of(labels + 1, 0); // segment matched to each object id
+  for (int c = 1; c <= g; ++c)
+    if (ids[c] > LABEL_STATIC && ids[c] <= labels)
+      segment_of[ids[c]] = c;
+  const auto n_min = static_cast<std::size_t>(params.static_min_cells);
+  const auto pair = [&grid](std::size_t i) {
+    return std::make_pair(grid.a[i].cast<double>(), grid.b[i].cast<double>());
+  };
+  for (int c = 1; c <= g; ++c) {
+    if (ids[c] != LABEL_STATIC)
+      continue;
+    const auto in_segment = [&](std::size_t i) {
+      return spatial.labels[i] == c && grid.valid_3d[i];
+    };
+    // One fit per previous label of the segment's cells.
+    std::vector<RigidFitAccumulator> fits(labels + 1);
+    for (std::size_t i = 0; i < grid.size(); ++i)
+      if (in_segment(i) && previous[i] != 0 && previous[i] <= labels) {
+        const auto [a, b] = pair(i);
+        fits[previous[i]].add(a, b);
+      }
+    Eigen::Matrix4d H_background;
+    if (fits[LABEL_STATIC].size() < n_min ||
+        fits[LABEL_STATIC].solve(H_background) != RigidFitStatus::ok)
+      continue;
+    // Objects whose former cells fit the background's motion `ratio` times worse (RMS)
+    // than their own keep those cells.
+    std::vector<std::pair<int, Eigen::Matrix4d>> apart;
+    for (int m = LABEL_STATIC + 1; m <= labels; ++m) {
+      Eigen::Matrix4d H_object;
+      if (segment_of[m] != 0)
+        H_object = spatial.motions[segment_of[m] - 1];
+      else if (fits[m].size() < n_min || fits[m].solve(H_object) != RigidFitStatus::ok)
+        continue;
+      double e_background = 0.0, e_object = 0.0;
+      for (std::size_t i = 0; i < grid.size(); ++i)
+        if (in_segment(i) && previous[i] == m) {
+          const auto [a, b] = pair(i);
+          e_background += squaredTransferError(H_background, a, b);
+          e_object += squaredTransferError(H_object, a, b);
+        }
+      if (fits[m].size() == 0 || e_background <= ratio * ratio * e_object)
+        continue;
+      apart.emplace_back(m, H_object);
+      for (std::size_t i = 0; i < grid.size(); ++i)
+        if (spatial.labels[i] == c && previous[i] == m)
+          tracked_[i] = static_cast<std::uint8_t>(m);
+    }
+    // Cells without a previous label go to the motion they fit best, so the object's
+    // newly seen cells do not leak into the background frame after frame.
+    for (std::size_t i = 0; !apart.empty() && i < grid.size(); ++i) {
+      if (!in_segment(i) || previous[i] != 0)
+        continue;
+      const auto [a, b] = pair(i);
+      double best = squaredTransferError(H_background, a, b);
+      for (const auto& [m, H_object] : apart) {
+        const double e = squaredTransferError(H_object, a, b);
+        if (e < best) {
+          best = e;
+          tracked_[i] = static_cast<std::uint8_t>(m);
+        }
+      }
+    }
+  }
+}
+
+void
 SegmentTracker::collectOutputs(const GridFlowData& grid,
                                const SpatialSegmentationResult& spatial,
                                const std::vector<int>& segment_ids,
@@ -322,6 +401,7 @@ SegmentTracker::update(const GridFlowData& grid,
   tracked_.resize(grid.size());
   for (std::size_t i = 0; i < grid.size(); ++i)
     tracked_[i] = static_cast<std::uint8_t>(ids[spatial.labels[i]]);
+  keepObjectsApart(grid, spatial, ids, params);
 
   // §6 then §5: carry the models into the current grid, fold in Ghat, read out L.
   sourcePixels(grid, T_pred, intrinsics);
@@ -329,6 +409,7 @@ SegmentTracker::update(const GridFlowData& grid,
   model_.update(tracked_, params.max_age);
 
   collectOutputs(grid, spatial, ids, T_pred);
+  previous_fused_ = fused_;
   buffer_.push_front(tracked_);
   while (static_cast<int>(buffer_.size()) > params.buffer_length)
     buffer_.pop_back();

@@ -185,6 +185,7 @@ TEST(RigidMotionSegmentationContract, BadParametersThrow)
   EXPECT_THROW(segmentation.setDbscanEpsilon(-1.0f), std::invalid_argument);
   EXPECT_THROW(segmentation.setMaxLabels(255), std::invalid_argument);
   EXPECT_THROW(segmentation.setMinCorrelation(0.0f), std::invalid_argument);
+  EXPECT_THROW(segmentation.setObjectSeparationRatio(-1.0f), std::invalid_argument);
   EXPECT_THROW(segmentation.setNumberOfThreads(0), std::invalid_argument);
   dynvo::CameraIntrinsics bad;
   bad.fx = 0.0;

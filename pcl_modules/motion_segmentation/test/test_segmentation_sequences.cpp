@@ -79,7 +79,12 @@ visibleCells(const dynvo::SynthFrame& frame,
 /// Renders frames first..first+frames-1 of a scenario and runs flow + segmentation on all
 /// but the first.
 std::vector<FrameRecord>
-runSequence(const std::string& scenario, int first, int frames, bool tracking)
+runSequence(const std::string& scenario,
+            int first,
+            int frames,
+            bool tracking,
+            float separation_ratio =
+                dynvo::RigidMotionSegmentationParameters().object_separation_ratio)
 {
   dynvo::SynthOptions options;
   options.scenario = scenario;
@@ -96,6 +101,7 @@ runSequence(const std::string& scenario, int first, int frames, bool tracking)
   segmentation.setCameraIntrinsics(synth.intrinsics());
   segmentation.setCellSize(CELL);
   segmentation.setTracking(tracking);
+  segmentation.setObjectSeparationRatio(separation_ratio);
 
   std::vector<FrameRecord> records;
   dynvo::SynthFrame previous;
@@ -274,10 +280,15 @@ TEST(SegmentationSequences, StopAndGo)
 
 TEST(SegmentationSequences, LargeOccluderDoesNotTakeTheBackgroundLabel)
 {
-  // moving_occluder: moving camera; the box approaches and, from about frame 62 on, covers
-  // more valid cells than the background (94 % at frame 119; later it hides the background
-  // completely, which no rule can survive, ALGORITHM.md §5).
-  const std::vector<FrameRecord> records = runSequence("moving_occluder", 55, 65, true);
+  // moving_occluder: moving camera; the box approaches, covers more valid cells than the
+  // background from about frame 80 on (89 % at its nearest, frame 157), slows to a halt
+  // there and recedes. While slow it moves less than the 5.5 mm inlier radius relative to
+  // the background, so the segmentation merges the two (ALGORITHM.md §12); without
+  // object_separation_ratio the box became background after alpha_max frames and kept
+  // label 1 once it sped up again (held on 48 of 125 frames, the background lost label 1
+  // entirely from frame 193).
+  const std::vector<FrameRecord> records =
+      runSequence("moving_occluder", 55, 150, true);
   int large = 0, held = 0;
   for (const FrameRecord& record : records) {
     int box = 0, background = 0, background_1 = 0, labelled_1 = 0;
@@ -292,14 +303,14 @@ TEST(SegmentationSequences, LargeOccluderDoesNotTakeTheBackgroundLabel)
     if (box <= background)
       continue; // score only the frames where the box covers most of the measured image
     ++large;
-    // Label 1 is on the background: nearly all label-1 cells are background (90 %), and
-    // they cover most of the measured background (the rest is held by the model's inertia).
-    held += labelled_1 > 0 && background_1 >= 0.9 * labelled_1 &&
-            background_1 >= 0.5 * background;
+    // Label 1 is on the background: it covers most of the measured background (the rest is
+    // held by the model's inertia), and at most 5 % of the box's cells carry it (cells on
+    // the box's silhouette mix both motions).
+    held += background_1 >= 0.5 * background && labelled_1 - background_1 <= 0.05 * box;
   }
   RecordProperty("background_held", std::to_string(held) + "/" + std::to_string(large));
-  ASSERT_GT(large, 40);
-  EXPECT_GE(held, 0.9 * large);
+  ASSERT_GT(large, 100);
+  EXPECT_GE(held, 0.95 * large);
 }
 
 } // namespace

@@ -201,6 +201,11 @@ public:
     updateField(&Parameters::static_min_cells, cells);
   }
   int getStaticMinCells() const { return params_.static_min_cells; }
+  void setObjectSeparationRatio(float ratio)
+  {
+    updateField(&Parameters::object_separation_ratio, ratio);
+  }
+  float getObjectSeparationRatio() const { return params_.object_separation_ratio; }
   void setSeed(std::uint32_t seed) { updateField(&Parameters::seed, seed); }
   std::uint32_t getSeed() const { return params_.seed; }
 

@@ -106,6 +106,20 @@ private:
   /// Smallest id in 2..n_obj neither in used_ nor in `taken`; 0 if none.
   int freeId(const std::vector<int>& taken) const;
 
+  /** \brief [D] Undoes the merge of a tracked object into the background segment.
+   *
+   * The segmentation cannot separate motions closer than its inlier radius (5.5 mm), so a
+   * slow object joins the background segment, and after alpha_max frames the dual model
+   * makes it background: a box covering 80 % of the image then took label 1 when it sped up
+   * again. Within each label-1 segment, the cells whose previous label is object m keep m
+   * when their residual under the background cells' fit is at least object_separation_ratio
+   * times (RMS) their residual under m's motion (its segment's, else a fit on them); cells
+   * without a previous label then take whichever of these motions fits them best.
+   */
+  void keepObjectsApart(const GridFlowData& grid,
+                        const SpatialSegmentationResult& spatial,
+                        const std::vector<int>& ids,
+                        const RigidMotionSegmentationParameters& params);
   /// Output ids and one motion per id.
   void collectOutputs(const GridFlowData& grid,
                       const SpatialSegmentationResult& spatial,
@@ -113,14 +127,15 @@ private:
                       const Eigen::Matrix4d& T_pred);
 
   std::deque<std::vector<std::uint8_t>>
-      buffer_;                           ///< Ghat of past frames, warped, newest first
-  DualLabelModel model_;                 ///< apparent / candidate models
-  std::vector<Eigen::Vector2f> source_;  ///< p_i used for compensation
-  std::vector<std::uint8_t> tracked_;    ///< Ghat
-  std::vector<std::uint8_t> fused_;      ///< output labels
-  std::vector<std::uint8_t> ids_;        ///< output ids
-  std::vector<Eigen::Matrix4d> motions_; ///< motion per output id
-  std::vector<char> used_;               ///< ids taken at the start of the frame
+      buffer_;                          ///< Ghat of past frames, warped, newest first
+  DualLabelModel model_;                ///< apparent / candidate models
+  std::vector<Eigen::Vector2f> source_; ///< p_i used for compensation
+  std::vector<std::uint8_t> tracked_;   ///< Ghat
+  std::vector<std::uint8_t> fused_;     ///< output labels
+  std::vector<std::uint8_t> previous_fused_; ///< output labels of the previous frame
+  std::vector<std::uint8_t> ids_;            ///< output ids
+  std::vector<Eigen::Matrix4d> motions_;     ///< motion per output id
+  std::vector<char> used_;                   ///< ids taken at the start of the frame
 };
 
 } // namespace dynvo
