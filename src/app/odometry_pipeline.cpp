@@ -122,6 +122,7 @@ struct OdometryPipeline::Impl {
                        static_cast<double>(options.min_inlier_threshold),
                        static_cast<double>(options.segmentation.inlier_threshold));
       segmentation.setInlierThreshold(static_cast<float>(inlier_threshold));
+      result.inlier_threshold = inlier_threshold;
       segmentation.setInputCloud(cloud);
       segmentation.setInputFlow(flow);
       segmentation.setPredictedMotion(T_curr_prev_predicted.cast<float>());

@@ -90,6 +90,9 @@ struct FrameResult {
   std::vector<std::uint8_t> segment_labels; ///< label id of each segment (1 = static)
   /// T_curr_prev of each segment (metres): objects' frame-to-frame motion in the current frame
   std::vector<Eigen::Matrix4f, Eigen::aligned_allocator<Eigen::Matrix4f>> motions;
+  /// segmentation inlier threshold used for this frame (m^2; noise-following, see
+  /// PipelineOptions::inlier_noise_factor), 0 without segmentation
+  double inlier_threshold = 0.0;
   std::uint32_t width = 0;  ///< image columns (px)
   std::uint32_t height = 0; ///< image rows (px)
   std::vector<std::uint8_t>
