@@ -59,6 +59,7 @@ visitFields(Options& o, Visit&& visit)
   visit("segmentation", "static_guard_tolerance", s.static_guard_tolerance);
   visit("segmentation", "static_min_cells", s.static_min_cells);
   visit("segmentation", "object_separation_ratio", s.object_separation_ratio);
+  visit("segmentation", "object_separation_hold", s.object_separation_hold);
   visit("segmentation", "seed", s.seed);
   auto& r = o.registration;
   visit("registration", "th_inlier", r.th_inlier);

@@ -62,6 +62,11 @@ RigidMotionSegmentationParameters::validate() const
   if (!(std::isfinite(object_separation_ratio) && object_separation_ratio >= 0.0f))
     fail("object_separation_ratio must be >= 0, got " +
          std::to_string(object_separation_ratio));
+  if (!(object_separation_hold >= 1.0f &&
+        (object_separation_ratio == 0.0f ||
+         object_separation_hold <= object_separation_ratio)))
+    fail("object_separation_hold must be in [1, object_separation_ratio], got " +
+         std::to_string(object_separation_hold));
 }
 
 } // namespace dynvo

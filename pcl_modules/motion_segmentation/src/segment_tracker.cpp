@@ -73,6 +73,7 @@ SegmentTracker::reset()
   tracked_.clear();
   fused_.clear();
   previous_fused_.clear();
+  separated_.clear();
   ids_.clear();
   motions_.clear();
 }
@@ -270,8 +271,10 @@ SegmentTracker::keepObjectsApart(const GridFlowData& grid,
                                  const RigidMotionSegmentationParameters& params)
 {
   const double ratio = params.object_separation_ratio;
-  if (ratio <= 0.0 || previous_fused_.size() != grid.size())
+  if (ratio <= 0.0 || previous_fused_.size() != grid.size()) {
+    separated_.clear();
     return;
+  }
   const std::vector<std::uint8_t> previous = warpNearest(previous_fused_, grid);
   const int g = spatial.segmentCount();
   const int labels = params.max_labels;
@@ -280,6 +283,12 @@ SegmentTracker::keepObjectsApart(const GridFlowData& grid,
     if (ids[c] > LABEL_STATIC && ids[c] <= labels)
       segment_of[ids[c]] = c;
   const auto n_min = static_cast<std::size_t>(params.static_min_cells);
+  separated_.resize(labels + 1, 0);
+  // Objects kept apart this frame; one kept apart before and still present as its own
+  // segment stays separated, so it is held with the lower ratio when it merges again.
+  std::vector<char> held(labels + 1, 0);
+  for (int m = LABEL_STATIC + 1; m <= labels; ++m)
+    held[m] = separated_[m] && segment_of[m] != 0;
   const auto pair = [&grid](std::size_t i) {
     return std::make_pair(grid.a[i].cast<double>(), grid.b[i].cast<double>());
   };
@@ -301,7 +310,8 @@ SegmentTracker::keepObjectsApart(const GridFlowData& grid,
         fits[LABEL_STATIC].solve(H_background) != RigidFitStatus::ok)
       continue;
     // Objects whose former cells fit the background's motion `ratio` times worse (RMS)
-    // than their own keep those cells.
+    // than their own keep those cells; an object already kept apart needs only
+    // object_separation_hold times worse.
     std::vector<std::pair<int, Eigen::Matrix4d>> apart;
     for (int m = LABEL_STATIC + 1; m <= labels; ++m) {
       Eigen::Matrix4d H_object;
@@ -316,8 +326,14 @@ SegmentTracker::keepObjectsApart(const GridFlowData& grid,
           e_background += squaredTransferError(H_background, a, b);
           e_object += squaredTransferError(H_object, a, b);
         }
-      if (fits[m].size() == 0 || e_background <= ratio * ratio * e_object)
+      if (segment_of[m] ==
+          0) // fitted on these very cells: 6 degrees of freedom used up
+        e_object *= static_cast<double>(fits[m].size()) /
+                    static_cast<double>(fits[m].size() - 6);
+      const double k = separated_[m] ? params.object_separation_hold : ratio;
+      if (fits[m].size() == 0 || e_background <= k * k * e_object)
         continue;
+      held[m] = 1;
       apart.emplace_back(m, H_object);
       for (std::size_t i = 0; i < grid.size(); ++i)
         if (spatial.labels[i] == c && previous[i] == m)
@@ -339,6 +355,7 @@ SegmentTracker::keepObjectsApart(const GridFlowData& grid,
       }
     }
   }
+  separated_ = held;
 }
 
 void

@@ -186,6 +186,9 @@ TEST(RigidMotionSegmentationContract, BadParametersThrow)
   EXPECT_THROW(segmentation.setMaxLabels(255), std::invalid_argument);
   EXPECT_THROW(segmentation.setMinCorrelation(0.0f), std::invalid_argument);
   EXPECT_THROW(segmentation.setObjectSeparationRatio(-1.0f), std::invalid_argument);
+  EXPECT_THROW(segmentation.setObjectSeparationHold(0.5f), std::invalid_argument);
+  EXPECT_THROW(segmentation.setObjectSeparationHold(4.0f),
+               std::invalid_argument); // > 3
   EXPECT_THROW(segmentation.setNumberOfThreads(0), std::invalid_argument);
   dynvo::CameraIntrinsics bad;
   bad.fx = 0.0;

@@ -206,6 +206,11 @@ public:
     updateField(&Parameters::object_separation_ratio, ratio);
   }
   float getObjectSeparationRatio() const { return params_.object_separation_ratio; }
+  void setObjectSeparationHold(float ratio)
+  {
+    updateField(&Parameters::object_separation_hold, ratio);
+  }
+  float getObjectSeparationHold() const { return params_.object_separation_hold; }
   void setSeed(std::uint32_t seed) { updateField(&Parameters::seed, seed); }
   std::uint32_t getSeed() const { return params_.seed; }
 

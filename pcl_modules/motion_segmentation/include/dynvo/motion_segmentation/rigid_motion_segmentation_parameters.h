@@ -68,6 +68,10 @@ struct DYNVO_EXPORTS RigidMotionSegmentationParameters {
   /// 3: measured largest ratio on TUM fr1/xyz (static scene, spurious objects) 2.8; a box
   /// covering 80 % of the image at 1.5-6 mm per frame relative motion 7.8-26.
   float object_separation_ratio = 3.0f;
+  /// k_hold (1..k_sep) [D]: the ratio that keeps an object apart once it has been kept apart
+  /// (hysteresis). 1.15: the moving_occluder box's ratio falls to 1.2 while it turns round at
+  /// 80 % of the image; a still object's is 1 (its own fit's 6 degrees of freedom discounted).
+  float object_separation_hold = 1.15f;
   /// seed: hypothesis sampling RNG, re-seeded on every segment()
   std::uint32_t seed = 0;
 

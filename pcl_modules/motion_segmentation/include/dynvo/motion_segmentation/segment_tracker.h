@@ -114,7 +114,9 @@ private:
    * again. Within each label-1 segment, the cells whose previous label is object m keep m
    * when their residual under the background cells' fit is at least object_separation_ratio
    * times (RMS) their residual under m's motion (its segment's, else a fit on them); cells
-   * without a previous label then take whichever of these motions fits them best.
+   * without a previous label then take whichever of these motions fits them best. An object
+   * kept apart, and present since (kept apart or as its own segment), needs only
+   * object_separation_hold times, so a large object turning round slowly stays an object.
    */
   void keepObjectsApart(const GridFlowData& grid,
                         const SpatialSegmentationResult& spatial,
@@ -133,9 +135,10 @@ private:
   std::vector<std::uint8_t> tracked_;   ///< Ghat
   std::vector<std::uint8_t> fused_;     ///< output labels
   std::vector<std::uint8_t> previous_fused_; ///< output labels of the previous frame
-  std::vector<std::uint8_t> ids_;            ///< output ids
-  std::vector<Eigen::Matrix4d> motions_;     ///< motion per output id
-  std::vector<char> used_;                   ///< ids taken at the start of the frame
+  std::vector<char> separated_;   ///< per id: kept apart from the background lately
+  std::vector<std::uint8_t> ids_; ///< output ids
+  std::vector<Eigen::Matrix4d> motions_; ///< motion per output id
+  std::vector<char> used_;               ///< ids taken at the start of the frame
 };
 
 } // namespace dynvo
