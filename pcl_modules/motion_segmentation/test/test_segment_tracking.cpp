@@ -273,13 +273,15 @@ TEST_F(BoxSequence, BoxCoveringMostOfTheImageDoesNotTakeTheBackgroundLabel)
 /// `steps[k]` metres along x in frame k: one cell column per frame while fast (4 cm at 1.2 m is
 /// 4.4 px), in place when slow. Flow noise 0.5 mm per axis, a new draw every frame.
 std::vector<int>
-boxLabels(const std::vector<double>& steps, float separation_ratio)
+boxLabels(const std::vector<double>& steps, float separation_ratio, float hold = 1.15f)
 {
   constexpr int CELL = 4;
   dynvo::RigidMotionSegmentation<pcl::PointXYZRGB> segmentation;
   segmentation.setCellSize(CELL);
   segmentation.setCameraIntrinsics(dynvo::test::intrinsicsFor(160));
   segmentation.setObjectSeparationRatio(separation_ratio);
+  if (separation_ratio > 0.0f)
+    segmentation.setObjectSeparationHold(hold);
   std::vector<int> labels;
   int col0 = 4;
   for (std::size_t k = 0; k < steps.size(); ++k) {
@@ -306,23 +308,26 @@ boxLabels(const std::vector<double>& steps, float separation_ratio)
 
 TEST(ObjectSeparation, SlowObjectStaysApartUntilItStops)
 {
-  // 4 cm per frame for 3 frames, then 4 mm per frame for 10 frames: within the 5.5 mm inlier
+  // 4 cm per frame for 3 frames, then 4 mm per frame for 5 frames: within the 5.5 mm inlier
   // radius, so the segmentation puts box and background in one segment, but the box's cells
   // fit the background's motion about 4.7 times worse (RMS: sqrt(16 + 0.75) / sqrt(0.75) mm
-  // with 0.5 mm noise per axis) than their own. Then it stops for 10 frames.
+  // with 0.5 mm noise per axis) than their own. Then 1.5 mm per frame for 8 frames (ratio
+  // about 2: below the entry ratio 3, above the hold 1.15), then still for 10 frames.
   std::vector<double> steps(3, 0.04);
-  steps.insert(steps.end(), 10, 0.004);
+  steps.insert(steps.end(), 5, 0.004);
+  steps.insert(steps.end(), 8, 0.0015);
   steps.insert(steps.end(), 10, 0.0);
   const std::vector<int> kept = boxLabels(steps, 3.0f);
-  for (int k = 1; k < 13; ++k)
+  for (int k = 1; k < 16; ++k)
     EXPECT_EQ(kept[k], 2) << "frame " << k;
   // Once still, its ratio is about 1: it becomes background after alpha_max (5) frames, as
   // the dual model intends (one frame of slack for the warped model).
-  for (int k = 13 + 6; k < 23; ++k)
+  for (int k = 16 + 6; k < 26; ++k)
     EXPECT_EQ(kept[k], 1) << "frame " << k;
-  // Without the rule the slow box already becomes background during the slow stretch.
-  const std::vector<int> merged = boxLabels(steps, 0.0f);
-  EXPECT_EQ(merged[3 + 6], 1);
+  // Without the hold the box merges during the 1.5 mm stretch; without the rule at all,
+  // already during the 4 mm one.
+  EXPECT_EQ(boxLabels(steps, 3.0f, 3.0f)[8 + 6], 1);
+  EXPECT_EQ(boxLabels(steps, 0.0f)[3 + 6], 1);
 }
 
 } // namespace
