@@ -309,48 +309,69 @@ SegmentTracker::keepObjectsApart(const GridFlowData& grid,
     if (fits[LABEL_STATIC].size() < n_min ||
         fits[LABEL_STATIC].solve(H_background) != RigidFitStatus::ok)
       continue;
+    // Each object with former cells here: its motion (its own segment's, else a fit on those
+    // cells) and the cells' residual sums under it and under the background's.
+    std::vector<Eigen::Matrix4d> H(labels + 1);
+    std::vector<char> tested(labels + 1, 0);
+    for (int m = LABEL_STATIC + 1; m <= labels; ++m) {
+      if (fits[m].size() == 0)
+        continue;
+      if (segment_of[m] != 0)
+        H[m] = spatial.motions[segment_of[m] - 1];
+      else if (fits[m].size() < std::max<std::size_t>(n_min, 7) ||
+               fits[m].solve(H[m]) !=
+                   RigidFitStatus::ok) // 7: see the n / (n - 6) below
+        continue;
+      tested[m] = 1;
+    }
+    std::vector<double> e_background(labels + 1, 0.0), e_object(labels + 1, 0.0);
+    for (std::size_t i = 0; i < grid.size(); ++i) {
+      const int m = previous[i];
+      if (m > LABEL_STATIC && m <= labels && tested[m] && in_segment(i)) {
+        const auto [a, b] = pair(i);
+        e_background[m] += squaredTransferError(H_background, a, b);
+        e_object[m] += squaredTransferError(H[m], a, b);
+      }
+    }
     // Objects whose former cells fit the background's motion `ratio` times worse (RMS)
     // than their own keep those cells; an object already kept apart needs only
     // object_separation_hold times worse.
-    std::vector<std::pair<int, Eigen::Matrix4d>> apart;
+    std::vector<char> kept(labels + 1, 0);
+    std::vector<int> apart;
     for (int m = LABEL_STATIC + 1; m <= labels; ++m) {
-      Eigen::Matrix4d H_object;
-      if (segment_of[m] != 0)
-        H_object = spatial.motions[segment_of[m] - 1];
-      else if (fits[m].size() < n_min || fits[m].solve(H_object) != RigidFitStatus::ok)
+      if (!tested[m])
         continue;
-      double e_background = 0.0, e_object = 0.0;
-      for (std::size_t i = 0; i < grid.size(); ++i)
-        if (in_segment(i) && previous[i] == m) {
-          const auto [a, b] = pair(i);
-          e_background += squaredTransferError(H_background, a, b);
-          e_object += squaredTransferError(H_object, a, b);
-        }
-      if (segment_of[m] ==
-          0) // fitted on these very cells: 6 degrees of freedom used up
-        e_object *= static_cast<double>(fits[m].size()) /
-                    static_cast<double>(fits[m].size() - 6);
+      // A motion fitted on these very cells used up 6 degrees of freedom of their residual.
+      if (segment_of[m] == 0)
+        e_object[m] *= static_cast<double>(fits[m].size()) /
+                       static_cast<double>(fits[m].size() - 6);
       const double k = separated_[m] ? params.object_separation_hold : ratio;
-      if (fits[m].size() == 0 || e_background <= k * k * e_object)
-        continue;
-      held[m] = 1;
-      apart.emplace_back(m, H_object);
-      for (std::size_t i = 0; i < grid.size(); ++i)
-        if (spatial.labels[i] == c && previous[i] == m)
-          tracked_[i] = static_cast<std::uint8_t>(m);
+      if (e_background[m] > k * k * e_object[m]) {
+        kept[m] = held[m] = 1;
+        apart.push_back(m);
+      }
     }
-    // Cells without a previous label go to the motion they fit best, so the object's
-    // newly seen cells do not leak into the background frame after frame.
-    for (std::size_t i = 0; !apart.empty() && i < grid.size(); ++i) {
-      if (!in_segment(i) || previous[i] != 0)
+    if (apart.empty())
+      continue;
+    // Their cells keep their label; cells without a previous label go to the motion they fit
+    // best, so the object's newly seen cells do not leak into the background frame after frame.
+    for (std::size_t i = 0; i < grid.size(); ++i) {
+      if (spatial.labels[i] != c)
+        continue;
+      const int m = previous[i];
+      if (m > LABEL_STATIC && m <= labels && kept[m]) {
+        tracked_[i] = static_cast<std::uint8_t>(m);
+        continue;
+      }
+      if (m != 0 || !grid.valid_3d[i])
         continue;
       const auto [a, b] = pair(i);
       double best = squaredTransferError(H_background, a, b);
-      for (const auto& [m, H_object] : apart) {
-        const double e = squaredTransferError(H_object, a, b);
+      for (const int object : apart) {
+        const double e = squaredTransferError(H[object], a, b);
         if (e < best) {
           best = e;
-          tracked_[i] = static_cast<std::uint8_t>(m);
+          tracked_[i] = static_cast<std::uint8_t>(object);
         }
       }
     }
