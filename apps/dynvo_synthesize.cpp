@@ -14,7 +14,7 @@
 namespace {
 
 const char* const USAGE =
-    "dynvo_synthesize -out DIR [-scenario NAME] [-frames N] [-seed S] [-noise 0|1] "
+    "dynvo_synthesize -out DIR [-scenario NAME] [-frames N] [-seed S] [-clean] "
     "[-threads N] [-width W -height H] | -list";
 
 /// Integer flag within [low, high]. \throws dynvo::app::UsageError otherwise
@@ -51,13 +51,13 @@ main(int argc, char** argv)
          {"seed", "S",
           "seed of textures and depth noise (default " + text(defaults.seed) + ")"},
          {"out", "DIR", "output folder; must not exist or be empty (required)"},
-         {"noise", "0|1",
-          "Kinect-like depth model (default " + text(int(defaults.noise)) + ")"},
+         {"clean", "", "exact depth (default: the Kinect v1 depth model)"},
          {"threads", "N",
           "worker threads (default: hardware count, " + text(hardware_threads) + ")"},
          {"width", "W", "image columns in px (default " + text(defaults.width) + ")"},
          {"height", "H", "image rows in px (default " + text(defaults.height) + ")"},
-         {"list", "", "print the scenarios and exit"}},
+         {"list", "",
+          "print the scenarios with their largest moving-pixel share and exit"}},
         0);
     if (args.helpRequested()) {
       std::printf(
@@ -68,8 +68,18 @@ main(int argc, char** argv)
       return 0;
     }
     if (args.has("list")) {
-      for (const dynvo::ScenarioInfo& info : dynvo::SceneSynthesizer::scenarios())
-        std::printf("%-16s  %s\n", info.name.c_str(), info.description.c_str());
+      // The moving share is counted on an 80x60 label render of the default length.
+      dynvo::SynthOptions probe;
+      probe.width = 80;
+      probe.height = 60;
+      probe.noise = false;
+      std::printf("%-18s %-8s %s\n", "# scenario", "moving", "description");
+      for (const dynvo::ScenarioInfo& info : dynvo::SceneSynthesizer::scenarios()) {
+        probe.scenario = info.name;
+        const double share = dynvo::SceneSynthesizer(probe).largestMovingShare();
+        std::printf("%-18s %5.1f %%  %s\n", info.name.c_str(), 100.0 * share,
+                    info.description.c_str());
+      }
       return 0;
     }
     if (!args.has("out"))
@@ -81,7 +91,7 @@ main(int argc, char** argv)
         static_cast<int>(boundedInteger(args, "frames", defaults.frames, 1, 1000000));
     options.seed = static_cast<std::uint32_t>(
         boundedInteger(args, "seed", defaults.seed, 0, 4294967295L));
-    options.noise = boundedInteger(args, "noise", defaults.noise ? 1 : 0, 0, 1) == 1;
+    options.noise = !args.has("clean");
     options.width =
         static_cast<int>(boundedInteger(args, "width", defaults.width, 8, 8192));
     options.height =
@@ -100,9 +110,9 @@ main(int argc, char** argv)
     timer.tic();
     dynvo::SceneSynthesizer(options).writeSequence(out, threads);
     pcl::console::print_highlight(
-        "Wrote %d frames of '%s' (%dx%d, seed %u, noise %s) to %s in ", options.frames,
+        "Wrote %d frames of '%s' (%dx%d, seed %u, %s depth) to %s in ", options.frames,
         options.scenario.c_str(), options.width, options.height, options.seed,
-        options.noise ? "on" : "off", out.c_str());
+        options.noise ? "Kinect" : "clean", out.c_str());
     pcl::console::print_value("%.2f", timer.toc() / 1000.0);
     pcl::console::print_info(" s with %d thread(s)\n", threads);
     return 0;

@@ -75,12 +75,13 @@ TEST(OdometryPipeline, FollowsAMovingCameraPastAMovingObject)
   const SequenceRun run = runScenario("moving_crossing", 45);
   for (std::size_t k = 0; k < run.lost.size(); ++k)
     EXPECT_FALSE(run.lost[k]) << "frame " << k;
-  // 1.5 s of Kinect-like noisy depth at 1-2.2 m (about 1-6 mm per pixel, under 1 mm after the
-  // depth window): the bound on the synthetic scenes is 0.02 m/s, and the box
-  // entering the view must not push the estimate beyond a seventh of it (measured 0.0017 m/s,
-  // 0.06 deg/s).
+  // 1.5 s of Kinect v1 depth in a room 1.5-4.3 m deep (sigma_z 3-27 mm per pixel, about a
+  // tenth of that after the depth window, plus shadows and dropouts): the bound on
+  // the synthetic scenes is 0.02 m/s, and the box entering the view must not push the
+  // estimate beyond a third of it (measured 0.0039 m/s; 0.0017 in the former 2.2 m room
+  // with z^2-only noise).
   const auto rpe = dynvo::computeRpe(run.groundtruth, run.estimate);
-  EXPECT_LT(rpe.trans_rmse, 0.003);
+  EXPECT_LT(rpe.trans_rmse, 0.007);
   EXPECT_LT(rpe.rot_rmse, 0.2);
 }
 

@@ -17,17 +17,33 @@ struct SineTerm {
   double phase;
 };
 
+/// A point the path passes through at progress s.
+struct Waypoint {
+  double s;                 ///< seconds of motion
+  Eigen::Vector3d position; ///< metres, added to the centre
+};
+
 /** \brief Smooth rigid motion as a function of the progress s (seconds of motion).
  *
- * translation(s) = centre + sum of translation terms;
- * rotation(s) = base_rotation * Ry(spin_rate s) * exp([sum of rotation terms]x).
+ * With r = s modulo repeat (r = s when repeat is 0):
+ * rotation(r) = base_rotation * Ry(spin_rate r) * exp([sum of rotation terms]x);
+ * translation(r) = centre + waypoint spline + velocity r + acceleration r^2 / 2 + sum
+ * of translation terms, minus orbit_radius times the optical (z) axis of rotation(r)
+ * (a camera circling `centre` while looking at it). The waypoint spline is a cubic
+ * Hermite through the waypoints (Catmull-Rom tangents, zero at the ends), held at the
+ * first and last position outside them.
  */
 struct RigidPath {
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();            ///< metres
   Eigen::Matrix3d base_rotation = Eigen::Matrix3d::Identity(); ///< at s = 0
   std::vector<SineTerm> translation;                           ///< metres
-  std::vector<SineTerm> rotation; ///< rotation vector (rad)
-  double spin_rate = 0.0;         ///< about local y (rad/s)
+  std::vector<SineTerm> rotation;                         ///< rotation vector (rad)
+  double spin_rate = 0.0;                                 ///< about local y (rad/s)
+  std::vector<Waypoint> waypoints;                        ///< increasing s
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();     ///< m/s
+  Eigen::Vector3d acceleration = Eigen::Vector3d::Zero(); ///< m/s^2
+  double orbit_radius = 0.0;                              ///< metres (0: no orbit)
+  double repeat = 0.0; ///< seconds of motion after which the path restarts
 
   Eigen::Isometry3d pose(double s) const;
 };
@@ -59,6 +75,7 @@ struct ScriptedBox {
 struct StaticBox {
   Eigen::Vector3d centre;       ///< metres, world
   Eigen::Vector3d half_extents; ///< metres
+  bool dark = false;            ///< dark, shiny material (almost no depth return)
 };
 
 /// The room shared by every scenario.
@@ -73,6 +90,7 @@ struct Scenario {
   std::string description;
   RigidPath camera; ///< T_world_camera as a function of time (progress = t)
   std::vector<ScriptedBox> objects;
+  double exposure = 0.0; ///< colour exposure (s) averaged into motion blur; 0 = sharp
 };
 
 /// The room (same for every scenario).

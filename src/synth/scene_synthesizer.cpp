@@ -5,6 +5,8 @@
 #include "scene_script.h"
 #include "synthesizer_impl.h"
 
+#include <dynvo/synth/depth_sensor_model.h>
+
 #include <Eigen/Core>
 
 #include <algorithm>
@@ -22,13 +24,15 @@ using detail::Scenario;
 
 constexpr float INF = std::numeric_limits<float>::infinity();
 constexpr double TWO_PI = 6.28318530717958647692;
-constexpr float AMBIENT = 0.45f; ///< light reaching faces turned away from the lamp
-constexpr float DIFFUSE = 0.55f; ///< Lambertian part at normal incidence
+constexpr float AMBIENT = 0.45f;     ///< light reaching faces turned away from the lamp
+constexpr float DIFFUSE = 0.55f;     ///< Lambertian part at normal incidence
+constexpr float DARK_ALBEDO = 0.12f; ///< brightness of dark materials
 constexpr float MIN_COSINE =
     0.25f; ///< footprint growth is capped at 4x at grazing angles
 constexpr int ROOM_SURFACES = 6;
 constexpr int FURNITURE_SURFACE_BASE = 6;
 constexpr int OBJECT_SURFACE_BASE = 64;
+constexpr int BLUR_SAMPLES = 7; ///< sub-frames averaged over a motion-blurred exposure
 
 /// Direction towards the (directional) light in the world: above, behind-left.
 Eigen::Vector3d
@@ -37,43 +41,33 @@ lightDirection()
   return Eigen::Vector3d(0.3, -0.8, -0.5).normalized();
 }
 
-/// Texture seed, base colour and shading of one flat face.
-struct SurfaceLook {
-  std::uint32_t salt;
-  float base[3];
-  float shade;
-};
-
 SurfaceLook
-surfaceLook(std::uint32_t seed, int surface, const Eigen::Vector3d& normal_world)
+surfaceLook(std::uint32_t seed,
+            int surface,
+            const Eigen::Vector3d& normal_world,
+            bool dark = false)
 {
   SurfaceLook look;
   look.salt = detail::mix32(detail::mix32(seed) ^ static_cast<std::uint32_t>(surface));
+  look.dark = dark;
   const std::uint32_t colour = detail::mix32(look.salt);
+  const float brightness = dark ? DARK_ALBEDO : 1.0f;
   for (int channel = 0; channel < 3; ++channel)
     look.base[channel] =
-        0.5f + 0.5f * static_cast<float>((colour >> (8 * channel)) & 255U) / 255.0f;
+        brightness *
+        (0.5f + 0.5f * static_cast<float>((colour >> (8 * channel)) & 255U) / 255.0f);
   look.shade =
       AMBIENT +
       DIFFUSE * static_cast<float>(std::max(0.0, normal_world.dot(lightDirection())));
   return look;
 }
 
-/// An oriented box as seen from one camera pose.
-struct FrameBox {
-  Eigen::Matrix3f ray_to_box;       ///< camera-frame ray direction to box frame
-  Eigen::Vector3f origin;           ///< camera centre in the box frame (metres)
-  Eigen::Vector3f half;             ///< half extents (metres)
-  std::uint8_t label;               ///< label written for its pixels (0 unless moving)
-  std::array<SurfaceLook, 6> faces; ///< face 2a + s: axis a, s = 1 on the + side
-  int u0, u1, v0, v1; ///< inclusive pixel rectangle holding its projection
-};
-
 FrameBox
 frameBox(const Eigen::Isometry3d& T_world_box,
          const Eigen::Vector3d& half,
          std::uint8_t label,
          int surface_base,
+         bool dark,
          const Eigen::Isometry3d& T_world_camera,
          const CameraIntrinsics& intrinsics,
          const SynthOptions& options)
@@ -88,7 +82,7 @@ frameBox(const Eigen::Isometry3d& T_world_box,
     const Eigen::Vector3d normal_box =
         (face % 2 == 1 ? 1.0 : -1.0) * Eigen::Vector3d::Unit(face / 2);
     box.faces[face] = surfaceLook(options.seed, surface_base + face,
-                                  T_world_box.linear() * normal_box);
+                                  T_world_box.linear() * normal_box, dark);
   }
   // Rectangle of the projected corners; a corner near or behind the camera plane
   // makes the whole image a candidate.
@@ -125,48 +119,6 @@ frameBox(const Eigen::Isometry3d& T_world_box,
   box.v0 = clampPixel(std::floor(v_min) - 1.0, options.height);
   box.v1 = clampPixel(std::ceil(v_max) + 1.0, options.height);
   return box;
-}
-
-/// Depth model of SceneSynthesizer's class documentation, applied in place.
-void
-applyDepthModel(
-    std::uint32_t seed, int k, int width, int height, std::vector<float>& depth)
-{
-  const std::vector<float> exact = depth;
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  const std::uint64_t frame_key = detail::splitMix64(
-      (static_cast<std::uint64_t>(seed) << 32) | static_cast<std::uint32_t>(k));
-  const float jump = static_cast<float>(SceneSynthesizer::EDGE_JUMP_RATIO);
-  for (int v = 0; v < height; ++v) {
-    for (int u = 0; u < width; ++u) {
-      const std::size_t i = static_cast<std::size_t>(v) * width + u;
-      const float z = exact[i];
-      const auto nearer = [&](std::size_t n) {
-        return z - exact[n] > jump * z;
-      };
-      const bool edge = (u > 0 && nearer(i - 1)) || (u + 1 < width && nearer(i + 1)) ||
-                        (v > 0 && nearer(i - width)) ||
-                        (v + 1 < height && nearer(i + width));
-      const std::uint64_t r1 = detail::splitMix64(frame_key + i);
-      const std::uint64_t r2 = detail::splitMix64(r1);
-      const double dropout = static_cast<double>(r1 >> 40) / 16777216.0;
-      if (edge || dropout < SceneSynthesizer::DROPOUT_RATE) {
-        depth[i] = nan;
-        continue;
-      }
-      // Box-Muller from two 24-bit uniforms (u1 in (0, 1], so the log is finite).
-      const double u1 = (static_cast<double>(r2 >> 40) + 1.0) / 16777216.0;
-      const double u2 = static_cast<double>(r2 & 0xFFFFFFU) / 16777216.0;
-      const double gauss = std::sqrt(-2.0 * std::log(u1)) * std::cos(TWO_PI * u2);
-      const double noisy = z + SceneSynthesizer::NOISE_SIGMA_PER_Z2 * z * z * gauss;
-      const double step = SceneSynthesizer::INVERSE_DEPTH_STEP;
-      const double measured = 1.0 / (std::round(1.0 / noisy / step) * step);
-      depth[i] = measured >= SceneSynthesizer::MIN_DEPTH &&
-                         measured <= SceneSynthesizer::MAX_DEPTH
-                     ? static_cast<float>(measured)
-                     : nan;
-    }
-  }
 }
 
 } // namespace
@@ -229,8 +181,12 @@ SceneSynthesizer::intrinsics() const
 FrameScript
 SceneSynthesizer::Impl::script(int k) const
 {
-  const double t = k / options.fps;
-  const double t_previous = (k - 1) / options.fps;
+  return scriptAt(k / options.fps, (k - 1) / options.fps);
+}
+
+FrameScript
+SceneSynthesizer::Impl::scriptAt(double t, double t_previous) const
+{
   FrameScript frame;
   // Whole microseconds, so the "%.6f" stamps of the files parse back to these values.
   frame.timestamp = std::round((FIRST_STAMP + t) * 1e6) / 1e6;
@@ -248,6 +204,184 @@ SceneSynthesizer::Impl::script(int k) const
   return frame;
 }
 
+SceneView::SceneView(const FrameScript& script,
+                     const CameraIntrinsics& intrinsics,
+                     const SynthOptions& options,
+                     bool with_room)
+    : intrinsics_(intrinsics)
+    , with_room_(with_room)
+{
+  const Room& room = detail::room();
+  if (with_room) {
+    for (std::size_t f = 0; f < room.furniture.size(); ++f) {
+      Eigen::Isometry3d T_world_box = Eigen::Isometry3d::Identity();
+      T_world_box.translation() = room.furniture[f].centre;
+      boxes_.push_back(frameBox(T_world_box, room.furniture[f].half_extents, 0,
+                                FURNITURE_SURFACE_BASE + 6 * static_cast<int>(f),
+                                room.furniture[f].dark, script.T_world_camera,
+                                intrinsics, options));
+    }
+    for (int face = 0; face < ROOM_SURFACES; ++face) // normals point into the room
+      room_faces_[face] =
+          surfaceLook(options.seed, face,
+                      (face % 2 == 1 ? -1.0 : 1.0) * Eigen::Vector3d::Unit(face / 2));
+  }
+  for (const ObjectState& object : script.objects)
+    boxes_.push_back(frameBox(object.T_world_object, object.half_extents,
+                              object.moving ? static_cast<std::uint8_t>(object.id) : 0,
+                              OBJECT_SURFACE_BASE + 6 * object.id, false,
+                              script.T_world_camera, intrinsics, options));
+  R_ = script.T_world_camera.linear().cast<float>();
+  o_ = script.T_world_camera.translation().cast<float>();
+  room_min_ = room.min_corner.cast<float>();
+  room_max_ = room.max_corner.cast<float>();
+}
+
+SceneView::~SceneView() = default;
+
+bool
+SceneView::movingRectangle(int& u0, int& u1, int& v0, int& v1) const
+{
+  bool any = false;
+  for (const FrameBox& box : boxes_) {
+    if (box.label == 0)
+      continue;
+    u0 = any ? std::min(u0, box.u0) : box.u0;
+    u1 = any ? std::max(u1, box.u1) : box.u1;
+    v0 = any ? std::min(v0, box.v0) : box.v0;
+    v1 = any ? std::max(v1, box.v1) : box.v1;
+    any = true;
+  }
+  return any;
+}
+
+bool
+SceneView::cast(int u, int v, PixelHit& out) const
+{
+  const CameraIntrinsics& K = intrinsics_;
+  // Ray with unit z in the camera frame: its parameter at a hit is the depth z.
+  const Eigen::Vector3f ray(static_cast<float>((u - K.cx) / K.fx),
+                            static_cast<float>((v - K.cy) / K.fy), 1.0f);
+  float t_best = INF;
+  int axis = 0;
+  const SurfaceLook* look = nullptr;
+  Eigen::Vector3f hit = Eigen::Vector3f::Zero();
+  float ray_along_normal = 1.0f;
+  std::uint8_t label = 0;
+  if (with_room_) {
+    // Leaving the room through the nearest of the three walls ahead.
+    const Eigen::Vector3f ray_world = R_ * ray;
+    for (int a = 0; a < 3; ++a) {
+      const float bound = std::signbit(ray_world[a]) ? room_min_[a] : room_max_[a];
+      const float t = (bound - o_[a]) / ray_world[a];
+      if (t < t_best) {
+        t_best = t;
+        axis = a;
+      }
+    }
+    look = &room_faces_[2 * axis + (ray_world[axis] > 0.0f ? 1 : 0)];
+    hit = o_ + t_best * ray_world;
+    ray_along_normal = ray_world[axis];
+  }
+  for (const FrameBox& box : boxes_) {
+    if (u < box.u0 || u > box.u1 || v < box.v0 || v > box.v1)
+      continue;
+    const Eigen::Vector3f d = box.ray_to_box * ray;
+    float t_near = -INF, t_far = INF;
+    int near_axis = 0;
+    for (int a = 0; a < 3; ++a) {
+      const float inv = 1.0f / d[a];
+      const float t1 = (-box.half[a] - box.origin[a]) * inv;
+      const float t2 = (box.half[a] - box.origin[a]) * inv;
+      const float lo = std::min(t1, t2);
+      if (lo > t_near) {
+        t_near = lo;
+        near_axis = a;
+      }
+      t_far = std::min(t_far, std::max(t1, t2));
+    }
+    if (t_near > t_far || t_near <= 0.0f || t_near >= t_best)
+      continue;
+    t_best = t_near;
+    axis = near_axis;
+    look = &box.faces[2 * axis + (d[axis] < 0.0f ? 1 : 0)];
+    hit = box.origin + t_near * d;
+    ray_along_normal = d[axis];
+    label = box.label;
+  }
+  if (look == nullptr)
+    return false;
+  const float ray_norm = ray.norm();
+  const float cosine = std::abs(ray_along_normal) / ray_norm;
+  const float footprint =
+      t_best * ray_norm /
+      (static_cast<float>(std::min(K.fx, K.fy)) * std::max(cosine, MIN_COSINE));
+  float albedo[3];
+  detail::surfaceAlbedo(hit[(axis + 1) % 3], hit[(axis + 2) % 3], look->base,
+                        look->salt, footprint, albedo);
+  for (int channel = 0; channel < 3; ++channel)
+    out.rgb[channel] = albedo[channel] * look->shade * 255.0f;
+  out.surface = {t_best, cosine, look->dark};
+  out.label = label;
+  return true;
+}
+
+void
+SceneView::blurColour(const std::vector<SceneView>& exposure,
+                      int width,
+                      int height,
+                      ColorImage& color)
+{
+  int u0 = 0, u1 = 0, v0 = 0, v1 = 0;
+  bool any = false;
+  for (const SceneView& view : exposure) {
+    int a0, a1, b0, b1;
+    if (!view.movingRectangle(a0, a1, b0, b1))
+      continue;
+    u0 = any ? std::min(u0, a0) : a0;
+    u1 = any ? std::max(u1, a1) : a1;
+    v0 = any ? std::min(v0, b0) : b0;
+    v1 = any ? std::max(v1, b1) : b1;
+    any = true;
+  }
+  if (!any)
+    return;
+  for (int v = std::max(v0, 0); v <= std::min(v1, height - 1); ++v) {
+    for (int u = std::max(u0, 0); u <= std::min(u1, width - 1); ++u) {
+      float sum[3] = {0.0f, 0.0f, 0.0f};
+      for (const SceneView& view : exposure) {
+        PixelHit hit;
+        view.cast(u, v, hit);
+        for (int channel = 0; channel < 3; ++channel)
+          sum[channel] += hit.rgb[channel];
+      }
+      const std::size_t i = static_cast<std::size_t>(v) * width + u;
+      for (int channel = 0; channel < 3; ++channel)
+        color.data[3 * i + channel] =
+            static_cast<std::uint8_t>(sum[channel] / exposure.size() + 0.5f);
+    }
+  }
+}
+
+double
+SceneSynthesizer::largestMovingShare() const
+{
+  const SynthOptions& options = impl_->options;
+  std::size_t largest = 0;
+  for (int k = 0; k < options.frames; ++k) {
+    const SceneView view(impl_->script(k), impl_->intrinsics, options, true);
+    std::size_t moving = 0;
+    for (int v = 0; v < options.height; ++v) {
+      for (int u = 0; u < options.width; ++u) {
+        PixelHit hit;
+        moving += view.cast(u, v, hit) && hit.label != 0;
+      }
+    }
+    largest = std::max(largest, moving);
+  }
+  return static_cast<double>(largest) / (options.width * options.height);
+}
+
 SynthFrame
 SceneSynthesizer::render(int k) const
 {
@@ -257,27 +391,7 @@ SceneSynthesizer::render(int k) const
                                 std::to_string(k) + " is outside [0, " +
                                 std::to_string(options.frames) + ")");
   FrameScript script = impl_->script(k);
-  const CameraIntrinsics& K = impl_->intrinsics;
-  const Room& room = detail::room();
-
-  std::vector<FrameBox> boxes;
-  for (std::size_t f = 0; f < room.furniture.size(); ++f) {
-    Eigen::Isometry3d T_world_box = Eigen::Isometry3d::Identity();
-    T_world_box.translation() = room.furniture[f].centre;
-    boxes.push_back(frameBox(T_world_box, room.furniture[f].half_extents, 0,
-                             FURNITURE_SURFACE_BASE + 6 * static_cast<int>(f),
-                             script.T_world_camera, K, options));
-  }
-  for (const ObjectState& object : script.objects)
-    boxes.push_back(frameBox(object.T_world_object, object.half_extents,
-                             object.moving ? static_cast<std::uint8_t>(object.id) : 0,
-                             OBJECT_SURFACE_BASE + 6 * object.id, script.T_world_camera,
-                             K, options));
-  std::array<SurfaceLook, ROOM_SURFACES> room_faces;
-  for (int face = 0; face < ROOM_SURFACES; ++face) // normals point into the room
-    room_faces[face] =
-        surfaceLook(options.seed, face,
-                    (face % 2 == 1 ? -1.0 : 1.0) * Eigen::Vector3d::Unit(face / 2));
+  const SceneView view(script, impl_->intrinsics, options, true);
 
   const int width = options.width, height = options.height;
   const std::size_t pixels = static_cast<std::size_t>(width) * height;
@@ -289,81 +403,40 @@ SceneSynthesizer::render(int k) const
   frame.color.width = frame.depth.width = width;
   frame.color.height = frame.depth.height = height;
   frame.color.data.resize(3 * pixels);
-  frame.depth.data.resize(pixels);
   frame.labels.assign(pixels, 0);
-
-  const Eigen::Matrix3f R = frame.T_world_camera.linear().cast<float>();
-  const Eigen::Vector3f o = frame.T_world_camera.translation().cast<float>();
-  const Eigen::Vector3f room_min = room.min_corner.cast<float>();
-  const Eigen::Vector3f room_max = room.max_corner.cast<float>();
-  const float inv_fx = static_cast<float>(1.0 / K.fx),
-              inv_fy = static_cast<float>(1.0 / K.fy);
-  const float focal = static_cast<float>(std::min(K.fx, K.fy));
-
+  std::vector<SurfaceSample> samples(pixels);
   for (int v = 0; v < height; ++v) {
     for (int u = 0; u < width; ++u) {
       const std::size_t i = static_cast<std::size_t>(v) * width + u;
-      // Ray with unit z in the camera frame: its parameter at a hit is the depth z.
-      const Eigen::Vector3f ray(static_cast<float>(u - K.cx) * inv_fx,
-                                static_cast<float>(v - K.cy) * inv_fy, 1.0f);
-      const Eigen::Vector3f ray_world = R * ray;
-      // Leaving the room through the nearest of the three walls ahead.
-      float t_best = INF;
-      int axis = 0;
-      for (int a = 0; a < 3; ++a) {
-        const float bound = std::signbit(ray_world[a]) ? room_min[a] : room_max[a];
-        const float t = (bound - o[a]) / ray_world[a];
-        if (t < t_best) {
-          t_best = t;
-          axis = a;
-        }
-      }
-      const SurfaceLook* look =
-          &room_faces[2 * axis + (ray_world[axis] > 0.0f ? 1 : 0)];
-      Eigen::Vector3f hit = o + t_best * ray_world;
-      float ray_along_normal = ray_world[axis];
-      std::uint8_t label = 0;
-      for (const FrameBox& box : boxes) {
-        if (u < box.u0 || u > box.u1 || v < box.v0 || v > box.v1)
-          continue;
-        const Eigen::Vector3f d = box.ray_to_box * ray;
-        float t_near = -INF, t_far = INF;
-        int near_axis = 0;
-        for (int a = 0; a < 3; ++a) {
-          const float inv = 1.0f / d[a];
-          const float t1 = (-box.half[a] - box.origin[a]) * inv;
-          const float t2 = (box.half[a] - box.origin[a]) * inv;
-          const float lo = std::min(t1, t2);
-          if (lo > t_near) {
-            t_near = lo;
-            near_axis = a;
-          }
-          t_far = std::min(t_far, std::max(t1, t2));
-        }
-        if (t_near > t_far || t_near <= 0.0f || t_near >= t_best)
-          continue;
-        t_best = t_near;
-        axis = near_axis;
-        look = &box.faces[2 * axis + (d[axis] < 0.0f ? 1 : 0)];
-        hit = box.origin + t_near * d;
-        ray_along_normal = d[axis];
-        label = box.label;
-      }
-      const float ray_norm = ray.norm();
-      const float cosine = std::max(std::abs(ray_along_normal) / ray_norm, MIN_COSINE);
-      const float footprint = t_best * ray_norm / (focal * cosine);
-      float albedo[3];
-      detail::surfaceAlbedo(hit[(axis + 1) % 3], hit[(axis + 2) % 3], look->base,
-                            look->salt, footprint, albedo);
+      PixelHit hit;
+      view.cast(u, v, hit); // inside the room every ray hits
       for (int channel = 0; channel < 3; ++channel)
         frame.color.data[3 * i + channel] =
-            static_cast<std::uint8_t>(albedo[channel] * look->shade * 255.0f + 0.5f);
-      frame.depth.data[i] = t_best;
-      frame.labels[i] = label;
+            static_cast<std::uint8_t>(hit.rgb[channel] + 0.5f);
+      samples[i] = hit.surface;
+      frame.labels[i] = hit.label;
     }
   }
-  if (options.noise)
-    applyDepthModel(options.seed, k, width, height, frame.depth.data);
+  const double exposure = impl_->scenario->exposure;
+  if (exposure > 0.0) {
+    std::vector<SceneView> views;
+    const double t = k / options.fps;
+    for (int j = 0; j < BLUR_SAMPLES; ++j) {
+      const double offset = exposure * (j / (BLUR_SAMPLES - 1.0) - 0.5);
+      views.emplace_back(impl_->scriptAt(t + offset, t - 1.0 / options.fps),
+                         impl_->intrinsics, options, true);
+    }
+    SceneView::blurColour(views, width, height, frame.color);
+  }
+  if (options.noise) {
+    DepthSensorModel::measure(samples, width, height, impl_->intrinsics.fx,
+                              options.seed, k, {}, frame.depth.data);
+  }
+  else {
+    frame.depth.data.resize(pixels);
+    for (std::size_t i = 0; i < pixels; ++i)
+      frame.depth.data[i] = samples[i].z;
+  }
   return frame;
 }
 

@@ -6,8 +6,12 @@
 
 #include "scene_script.h"
 
+#include <dynvo/synth/depth_sensor_model.h>
+
 #include <Eigen/Geometry>
 
+#include <array>
+#include <cstdint>
 #include <vector>
 
 namespace dynvo {
@@ -20,6 +24,63 @@ struct FrameScript {
   std::vector<ObjectState> objects; ///< every scripted object
 };
 
+/// Texture seed, base colour, shading and material of one flat face.
+struct SurfaceLook {
+  std::uint32_t salt;
+  float base[3];
+  float shade;
+  bool dark; ///< dark or shiny: no structured-light return (DepthSensorModel)
+};
+
+/// An oriented box as seen from one camera pose.
+struct FrameBox {
+  Eigen::Matrix3f ray_to_box;       ///< camera-frame ray direction to box frame
+  Eigen::Vector3f origin;           ///< camera centre in the box frame (metres)
+  Eigen::Vector3f half;             ///< half extents (metres)
+  std::uint8_t label;               ///< label written for its pixels (0 unless moving)
+  std::array<SurfaceLook, 6> faces; ///< face 2a + s: axis a, s = 1 on the + side
+  int u0, u1, v0, v1; ///< inclusive pixel rectangle holding its projection
+};
+
+/// One pixel's ray hit: colour before rounding, the surface, and its label.
+struct PixelHit {
+  float rgb[3] = {0.0f, 0.0f, 0.0f}; ///< 0-255
+  SurfaceSample surface;             ///< z NaN when nothing was hit
+  std::uint8_t label = 0;            ///< object id while it moves, else 0
+};
+
+/// The scene of one instant as seen by the camera: ray casting per pixel.
+class SceneView {
+public:
+  /// with_room false: only the scripted objects (for compositing into real frames)
+  SceneView(const FrameScript& script,
+            const CameraIntrinsics& intrinsics,
+            const SynthOptions& options,
+            bool with_room);
+  ~SceneView();
+
+  /// Casts the ray of pixel (u, v); false (and `out` untouched) when nothing is hit.
+  bool cast(int u, int v, PixelHit& out) const;
+
+  /// Pixel rectangle holding every moving object (inclusive); false when none moves.
+  bool movingRectangle(int& u0, int& u1, int& v0, int& v1) const;
+
+  /// Replaces the colour inside the moving objects' rectangles by the mean over the
+  /// views of one exposure (motion blur).
+  static void blurColour(const std::vector<SceneView>& exposure,
+                         int width,
+                         int height,
+                         ColorImage& color);
+
+private:
+  CameraIntrinsics intrinsics_;
+  bool with_room_;
+  std::vector<FrameBox> boxes_;
+  std::array<SurfaceLook, 6> room_faces_;
+  Eigen::Matrix3f R_;
+  Eigen::Vector3f o_, room_min_, room_max_;
+};
+
 struct SceneSynthesizer::Impl {
   SynthOptions options;
   const detail::Scenario* scenario = nullptr;
@@ -27,6 +88,9 @@ struct SceneSynthesizer::Impl {
 
   /// Poses, motion flags and stamps of frame k (0 <= k < frames).
   FrameScript script(int k) const;
+
+  /// Poses at time t (s); objects are "moving" when their pose differs at t_previous.
+  FrameScript scriptAt(double t, double t_previous) const;
 };
 
 } // namespace dynvo

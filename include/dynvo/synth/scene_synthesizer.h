@@ -54,8 +54,7 @@ struct DYNVO_EXPORTS SynthOptions {
   int width = 640;        ///< image columns (px)
   int height = 480;       ///< image rows (px)
   double fps = 30.0;      ///< frame rate (Hz)
-  bool noise =
-      true; ///< Kinect-like depth model on; off = exact depth, no holes or dropouts
+  bool noise = true;      ///< DepthSensorModel on; off = exact depth everywhere
   /// Intrinsics at 640x480 (scaled with width/height); the "default" preset.
   CameraIntrinsics intrinsics;
 
@@ -66,8 +65,9 @@ struct DYNVO_EXPORTS SynthOptions {
 /** \brief Renders scripted dynamic scenes by ray casting (deterministic for a seed).
  *
  * World frame: x right, y down (floor at y = +1.0), z forward, metres. The room spans
- * [-2.0, 2.0] x [-1.3, 1.0] x [-1.0, 2.2] and holds two static furniture boxes; the
- * scripted objects are oriented boxes. Every pixel casts one ray through its centre; the
+ * [-2.2, 2.2] x [-1.4, 1.0] x [-1.0, 4.0] (the far wall 3.7-4.3 m from the camera, as in
+ * real rooms) and holds five static furniture boxes at 1.5-3.9 m, one of them dark (no
+ * depth return); the scripted objects are oriented boxes. Every pixel casts one ray through its centre; the
  * depth is the hit point's z in the camera frame (TUM convention, not the range).
  *
  * Appearance: every face carries its own procedural texture (seeded): two layers of
@@ -79,18 +79,22 @@ struct DYNVO_EXPORTS SynthOptions {
  * surface looks the same from every viewpoint (no shadows, no specular highlights).
  *
  * Motion: the camera follows sums of sinusoids (about 0.1-0.3 m/s and up to about
- * 4 deg/s) in the moving-camera scenarios and is fixed (constant, non-identity pose
- * looking 11.5 deg down) in the static ones. Objects follow smooth 6-DoF scripts at about
- * 1-5 cm per frame at 30 Hz; stop_and_go objects rest for stretches and then move with
- * 0.25 s raised-cosine speed ramps. Object k is "moving" at frame k exactly when its pose
+ * 4 deg/s; circling_bobbing circles its box at up to 9 deg/s) in the moving-camera
+ * scenarios and is fixed (constant, non-identity pose looking 11.5 deg down) in the
+ * static ones. Objects follow smooth 6-DoF scripts (sinusoids, Hermite splines through
+ * waypoints, or a shallow arc) at 0.3-5 cm per frame at 30 Hz, except the cube of
+ * thrown_object (about 13 cm, up to 35 px per frame); stop_and_go and enter_stop_leave
+ * objects rest for stretches and move with 0.25 s raised-cosine speed ramps. Object k is "moving" at frame k exactly when its pose
  * differs from the one at the previous frame, and only then labels its pixels with k.
  *
- * Depth model (SynthOptions::noise): Gaussian noise with sigma = NOISE_SIGMA_PER_Z2 z^2,
- * Kinect disparity quantisation (inverse depth in steps of INVERSE_DEPTH_STEP), holes on
- * the far side of depth jumps larger than EDGE_JUMP_RATIO of the depth, DROPOUT_RATE
- * random dropouts, and no measurement outside [MIN_DEPTH, MAX_DEPTH]. The random numbers
- * are a hash of (seed, frame, pixel), so render(k) does not depend on call order or
- * threads. Without noise the depth is the exact ray depth everywhere.
+ * Depth model (SynthOptions::noise): DepthSensorModel (Kinect v1 / Xtion: axial noise
+ * growing with (z - 0.4 m)^2, 1/8 px disparity quantisation, projector shadows, dropouts
+ * at depth edges, at grazing angles and on dark surfaces, speckle, 0.5-4.5 m range).
+ * Without noise the depth is the exact ray depth everywhere.
+ *
+ * Motion blur: scenarios with an exposure (thrown_object) average the colour of
+ * BLUR_SAMPLES instants across it inside the moving objects' pixel rectangle; depth and
+ * labels show the frame's instant.
  *
  * Timestamps: colour stamp FIRST_STAMP + k / fps, depth stamp DEPTH_STAMP_DELAY later,
  * both rounded to whole microseconds (the "%.6f" of the files parses back exactly);
@@ -105,14 +109,6 @@ struct DYNVO_EXPORTS SynthOptions {
  */
 class DYNVO_EXPORTS SceneSynthesizer {
 public:
-  static constexpr double MIN_DEPTH = 0.5; ///< nearest measurable depth (m)
-  static constexpr double MAX_DEPTH = 4.5; ///< farthest measurable depth (m)
-  static constexpr double NOISE_SIGMA_PER_Z2 = 1.2e-3; ///< noise sigma / z^2 (1/m)
-  /// Kinect inverse-depth step (1/m): 1/8 px disparity / (0.075 m baseline * 580 px).
-  static constexpr double INVERSE_DEPTH_STEP = 0.125 / (0.075 * 580.0);
-  static constexpr double DROPOUT_RATE = 0.01; ///< fraction of pixels randomly lost
-  static constexpr double EDGE_JUMP_RATIO =
-      0.05; ///< depth jump (fraction of z) making a hole
   static constexpr double FIRST_STAMP = 1.0;         ///< colour stamp of frame 0 (s)
   static constexpr double DEPTH_STAMP_DELAY = 0.005; ///< depth stamp - colour stamp (s)
   static constexpr double DEPTH_PNG_SCALE = 5000.0;  ///< depth PNG units per metre
@@ -126,6 +122,10 @@ public:
 
   /// Intrinsics actually used (scaled to the image size).
   CameraIntrinsics intrinsics() const;
+
+  /// Largest share of the image labelled as moving over all frames (labels only: no
+  /// shading, no depth model).
+  double largestMovingShare() const;
 
   /// Render frame k (0 <= k < frames). Independent of call order; thread-safe.
   /// \throws std::invalid_argument when k is out of range
