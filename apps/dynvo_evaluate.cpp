@@ -1,14 +1,62 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // dynvo_evaluate GT EST: RPE and ATE of an estimated TUM trajectory against ground truth.
+// dynvo_evaluate -labels PRED_DIR -truth SEQ_DIR: segmentation scores of label PNGs.
 #include <dynvo/app/cli.h>
+#include <dynvo/eval/label_metrics.h>
 #include <dynvo/eval/trajectory_metrics.h>
 
+#include <pcl/console/print.h>
+
+#include <algorithm>
 #include <cstdio>
+#include <string>
 
 namespace {
 
 const char* const USAGE =
-    "dynvo_evaluate GROUNDTRUTH ESTIMATE [-delta D] [-delta_unit s|f] [-json]";
+    "dynvo_evaluate GROUNDTRUTH ESTIMATE [-delta D] [-delta_unit s|f] [-json]\n"
+    "       dynvo_evaluate -labels PRED_DIR -truth SEQ_DIR [-json]";
+
+const char* const SEGMENTATION_HELP =
+    "predicted labels (0 none, 1 static, 2.. objects) against SEQ_DIR/labels\n"
+    "(0 static, k moving object k), on pixels with valid depth, frames paired by\n"
+    "stamp within 0.005 s. Prints moving_iou static_precision static_recall\n"
+    "labelled bg_ok id_switch_rate frames; without SEQ_DIR/labels (a static\n"
+    "recording) moving_share labelled frames. Definitions: README.md, dynvo_evaluate.";
+
+/// -labels selects the segmentation mode, which takes no positional arguments.
+bool
+labelsMode(int argc, char** argv)
+{
+  return std::any_of(argv + 1, argv + argc, [](const char* token) {
+    return std::string(token) == "-labels";
+  });
+}
+
+/// The segmentation mode: scores of -labels against -truth.
+int
+evaluateLabels(const dynvo::app::Arguments& args)
+{
+  if (!args.has("truth"))
+    throw dynvo::app::UsageError("-labels needs -truth SEQ_DIR");
+  for (const char* trajectory_only : {"delta", "delta_unit"})
+    if (args.has(trajectory_only))
+      throw dynvo::app::UsageError(std::string("-") + trajectory_only +
+                                   " applies to trajectories, not to -labels");
+  const dynvo::SegmentationEvaluation result =
+      dynvo::evaluateSegmentation(args.string("labels"), args.string("truth"));
+  if (result.scores.frames < result.sequence_frames)
+    pcl::console::print_warn(
+        "Warning: %zu of %zu frames of %s have no label PNG within %.3f s in %s; "
+        "they are not scored\n",
+        result.sequence_frames - result.scores.frames, result.sequence_frames,
+        args.string("truth").c_str(),
+        dynvo::SegmentationEvaluationOptions{}.max_difference,
+        args.string("labels").c_str());
+  std::printf("%s\n",
+              dynvo::formatSegmentationScores(result, args.has("json")).c_str());
+  return 0;
+}
 
 } // namespace
 
@@ -17,20 +65,30 @@ main(int argc, char** argv)
 {
   return dynvo::app::runApp(USAGE, [&] {
     const dynvo::RpeOptions defaults;
+    const bool labels = labelsMode(argc, argv);
     const dynvo::app::Arguments args(
         argc, argv,
         {{"delta", "D", "RPE pair spacing (default 1)"},
          {"delta_unit", "s|f", "unit of -delta: seconds or frames (default s)"},
-         {"json", "", "print the result as one JSON object"}},
-        2);
+         {"json", "", "print the result as one JSON object"},
+         {"labels", "DIR",
+          "predicted label PNGs <stamp>.png (dynvo_odometry -labels_dir)"},
+         {"truth", "DIR",
+          "sequence folder scored against (labels/, depth.txt, rgb.txt)"}},
+        labels ? 0 : 2);
     if (args.helpRequested()) {
       std::printf(
           "Usage: %s\n\nRelative pose error as TUM evaluate_rpe.py --fixed_delta "
           "and absolute trajectory error as evaluate_ate.py.\nBoth files are TUM "
           "trajectories (timestamp tx ty tz qx qy qz qw, camera-to-world).\n\n%s",
           USAGE, args.optionsHelp().c_str());
+      std::printf("\nWith -labels: %s\n", SEGMENTATION_HELP);
       return 0;
     }
+    if (labels)
+      return evaluateLabels(args);
+    if (args.has("truth"))
+      throw dynvo::app::UsageError("-truth needs -labels PRED_DIR");
     dynvo::RpeOptions options;
     options.delta = args.number("delta", defaults.delta);
     if (!(options.delta > 0.0))
