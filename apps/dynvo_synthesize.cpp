@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // dynvo_synthesize: writes a deterministic synthetic dynamic-scene RGB-D sequence (TUM layout).
 #include <dynvo/app/cli.h>
+#include <dynvo/app/frame_source_args.h>
 #include <dynvo/synth/scene_synthesizer.h>
 
 #include <pcl/console/print.h>
@@ -15,7 +16,8 @@ namespace {
 
 const char* const USAGE =
     "dynvo_synthesize -out DIR [-scenario NAME] [-frames N] [-seed S] [-clean] "
-    "[-threads N] [-width W -height H] | -list";
+    "[-threads N] [-width W -height H] | -composite TUM_DIR -scenario NAME -out DIR "
+    "[-frames N] [-seed S] [-camera C] [-fx -fy -cx -cy] [-depth_scale S] | -list";
 
 /// Integer flag within [low, high]. \throws dynvo::app::UsageError otherwise
 long
@@ -33,6 +35,50 @@ boundedInteger(const dynvo::app::Arguments& args,
   return value;
 }
 
+/// -composite: the scenario's objects rendered into a real recording.
+int
+composite(const dynvo::app::Arguments& args)
+{
+  for (const char* name : {"clean", "threads", "width", "height"})
+    if (args.has(name))
+      throw dynvo::app::UsageError(std::string("-") + name +
+                                   " does not apply to -composite");
+  dynvo::SynthOptions options;
+  options.scenario = args.string("scenario", options.scenario);
+  options.seed = static_cast<std::uint32_t>(
+      boundedInteger(args, "seed", options.seed, 0, 4294967295L));
+  dynvo::CompositeOptions composite;
+  composite.recording = args.string("composite");
+  composite.intrinsics = dynvo::app::intrinsicsFromArguments(args);
+  composite.depth_scale = args.number("depth_scale", 0.0);
+  if (args.has("depth_scale") && !(composite.depth_scale > 0.0))
+    throw dynvo::app::UsageError("-depth_scale must be positive");
+  if (args.has("frames"))
+    composite.frames = static_cast<int>(boundedInteger(args, "frames", 0, 1, 1000000));
+  options.intrinsics = composite.intrinsics;
+  try {
+    options.validate();
+  }
+  catch (const std::invalid_argument& e) {
+    throw dynvo::app::UsageError(e.what());
+  }
+  const std::string out = args.string("out");
+  pcl::console::TicToc timer;
+  timer.tic();
+  try {
+    dynvo::SceneSynthesizer(options).writeComposite(composite, out);
+  }
+  catch (const std::invalid_argument& e) { // a scenario without objects
+    throw dynvo::app::UsageError(e.what());
+  }
+  pcl::console::print_highlight("Composited '%s' (seed %u) into %s, wrote %s in ",
+                                options.scenario.c_str(), options.seed,
+                                composite.recording.c_str(), out.c_str());
+  pcl::console::print_value("%.2f", timer.toc() / 1000.0);
+  pcl::console::print_info(" s\n");
+  return 0;
+}
+
 } // namespace
 
 int
@@ -44,21 +90,27 @@ main(int argc, char** argv)
     const auto text = [](auto value) {
       return std::to_string(value);
     };
-    const dynvo::app::Arguments args(
-        argc, argv,
-        {{"scenario", "NAME", "scenario to render (default " + defaults.scenario + ")"},
-         {"frames", "N", "number of frames (default " + text(defaults.frames) + ")"},
-         {"seed", "S",
-          "seed of textures and depth noise (default " + text(defaults.seed) + ")"},
-         {"out", "DIR", "output folder; must not exist or be empty (required)"},
-         {"clean", "", "exact depth (default: the Kinect v1 depth model)"},
-         {"threads", "N",
-          "worker threads (default: hardware count, " + text(hardware_threads) + ")"},
-         {"width", "W", "image columns in px (default " + text(defaults.width) + ")"},
-         {"height", "H", "image rows in px (default " + text(defaults.height) + ")"},
-         {"list", "",
-          "print the scenarios with their largest moving-pixel share and exit"}},
-        0);
+    std::vector<dynvo::app::Option> options_list = {
+        {"scenario", "NAME", "scenario to render (default " + defaults.scenario + ")"},
+        {"frames", "N", "number of frames (default " + text(defaults.frames) + ")"},
+        {"seed", "S",
+         "seed of textures and depth noise (default " + text(defaults.seed) + ")"},
+        {"out", "DIR", "output folder; must not exist or be empty (required)"},
+        {"clean", "", "exact depth (default: the Kinect v1 depth model)"},
+        {"threads", "N",
+         "worker threads (default: hardware count, " + text(hardware_threads) + ")"},
+        {"width", "W", "image columns in px (default " + text(defaults.width) + ")"},
+        {"height", "H", "image rows in px (default " + text(defaults.height) + ")"},
+        {"list", "",
+         "print the scenarios with their largest moving-pixel share and exit"},
+        {"composite", "TUM_DIR",
+         "render the scenario's objects into this real recording (its ground truth "
+         "gives the camera; -frames N takes the first N frames, default all)"}};
+    for (const dynvo::app::Option& option : dynvo::app::frameSourceOptions())
+      for (const char* name : {"camera", "fx", "fy", "cx", "cy", "depth_scale"})
+        if (option.name == name)
+          options_list.push_back(option);
+    const dynvo::app::Arguments args(argc, argv, options_list, 0);
     if (args.helpRequested()) {
       std::printf(
           "Usage: %s\n\nRenders textured rooms with rigid moving objects and writes "
@@ -84,6 +136,11 @@ main(int argc, char** argv)
     }
     if (!args.has("out"))
       throw dynvo::app::UsageError("-out DIR is required");
+    if (args.has("composite"))
+      return composite(args);
+    for (const char* name : {"camera", "fx", "fy", "cx", "cy", "depth_scale"})
+      if (args.has(name))
+        throw dynvo::app::UsageError(std::string("-") + name + " needs -composite");
 
     dynvo::SynthOptions options;
     options.scenario = args.string("scenario", defaults.scenario);

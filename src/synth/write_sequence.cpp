@@ -30,8 +30,10 @@ namespace {
 /// zlib level 1: the textures are incompressible noise, so higher levels buy little.
 constexpr int PNG_COMPRESSION = 1;
 
+} // namespace
+
 void
-writePng(const fs::path& path, const cv::Mat& image)
+detail::writePng(const fs::path& path, const cv::Mat& image)
 {
   bool written = false;
   try {
@@ -44,6 +46,8 @@ writePng(const fs::path& path, const cv::Mat& image)
   if (!written)
     throw pcl::IOException(path.string() + ": cannot write PNG");
 }
+
+namespace {
 
 void
 writeFrame(const fs::path& root, const SynthFrame& frame)
@@ -65,15 +69,29 @@ writeFrame(const fs::path& root, const SynthFrame& frame)
                                    std::round(z * SceneSynthesizer::DEPTH_PNG_SCALE));
     }
   }
-  writePng(root / "rgb" / stampedPngName(frame.timestamp), bgr);
-  writePng(root / "depth" / stampedPngName(frame.depth_timestamp), depth);
-  writeLabelImage((root / "labels" / stampedPngName(frame.timestamp)).string(),
-                  {frame.color.width, frame.color.height, frame.labels});
+  detail::writeFrameFiles(root, frame.timestamp, frame.depth_timestamp, bgr, depth,
+                          frame.labels);
 }
 
-/// Refuses anything but a missing or empty folder, then creates the layout's folders.
+} // namespace
+
 void
-prepareFolder(const fs::path& root)
+detail::writeFrameFiles(const fs::path& root,
+                        double rgb_stamp,
+                        double depth_stamp,
+                        const cv::Mat& bgr,
+                        const cv::Mat& depth,
+                        const std::vector<std::uint8_t>& labels)
+{
+  writePng(root / "rgb" / stampedPngName(rgb_stamp), bgr);
+  writePng(root / "depth" / stampedPngName(depth_stamp), depth);
+  writeLabelImage((root / "labels" / stampedPngName(rgb_stamp)).string(),
+                  {static_cast<std::uint32_t>(bgr.cols),
+                   static_cast<std::uint32_t>(bgr.rows), labels});
+}
+
+void
+detail::prepareFolder(const fs::path& root)
 {
   std::error_code error;
   if (fs::exists(root, error)) {
@@ -90,6 +108,8 @@ prepareFolder(const fs::path& root)
                              error.message() + ")");
   }
 }
+
+namespace {
 
 /// Opens a text file for writing. \throws pcl::IOException
 std::ofstream
@@ -119,7 +139,7 @@ SceneSynthesizer::writeSequence(const std::string& folder, int threads) const
                                 "be >= 1, got " +
                                 std::to_string(threads));
   const fs::path root(folder);
-  prepareFolder(root);
+  detail::prepareFolder(root);
   const int frames = impl_->options.frames;
 
   std::atomic<int> next_frame{0};
@@ -147,26 +167,40 @@ SceneSynthesizer::writeSequence(const std::string& folder, int threads) const
   if (first_error)
     std::rethrow_exception(first_error);
 
-  const std::string origin = "# dynvo synthetic scenario '" + impl_->options.scenario +
-                             "', seed " + std::to_string(impl_->options.seed) + "\n";
+  std::vector<FrameScript> scripts;
+  Trajectory trajectory;
+  for (int k = 0; k < frames; ++k) {
+    scripts.push_back(impl_->script(k));
+    trajectory.push_back({scripts.back().timestamp, scripts.back().T_world_camera});
+  }
+  detail::writeIndexFiles(root,
+                          "# dynvo synthetic scenario '" + impl_->options.scenario +
+                              "', seed " + std::to_string(impl_->options.seed) + "\n",
+                          scripts, trajectory);
+}
+
+void
+detail::writeIndexFiles(const fs::path& root,
+                        const std::string& origin,
+                        const std::vector<FrameScript>& scripts,
+                        const Trajectory& groundtruth)
+{
   const fs::path rgb_path = root / "rgb.txt", depth_path = root / "depth.txt";
   const fs::path objects_path = root / "objects.txt";
   std::ofstream rgb = openText(rgb_path), depth = openText(depth_path);
   std::ofstream objects = openText(objects_path);
   rgb << "# color images\n" << origin << "# timestamp filename\n";
-  depth << "# depth maps (16-bit PNG, " << DEPTH_PNG_SCALE << " per metre, 0 = none)\n"
+  depth << "# depth maps (16-bit PNG, " << SceneSynthesizer::DEPTH_PNG_SCALE
+        << " per metre, 0 = none)\n"
         << origin << "# timestamp filename\n";
   objects << "# object poses (object-to-world, metres); moving = pose changed since "
              "the previous frame\n"
           << origin << "# timestamp id tx ty tz qx qy qz qw moving\n";
-  Trajectory trajectory;
-  for (int k = 0; k < frames; ++k) {
-    const FrameScript script = impl_->script(k);
+  for (const FrameScript& script : scripts) {
     const std::string colour = formatStamp(script.timestamp);
     const std::string depth_stamp = formatStamp(script.depth_timestamp);
     rgb << colour << " rgb/" << colour << ".png\n";
     depth << depth_stamp << " depth/" << depth_stamp << ".png\n";
-    trajectory.push_back({script.timestamp, script.T_world_camera});
     for (const ObjectState& object : script.objects) {
       std::string line = formatTumLine({script.timestamp, object.T_world_object});
       line.insert(line.find(' '), " " + std::to_string(object.id));
@@ -176,7 +210,7 @@ SceneSynthesizer::writeSequence(const std::string& folder, int threads) const
   closeText(rgb, rgb_path);
   closeText(depth, depth_path);
   closeText(objects, objects_path);
-  writeTrajectory((root / "groundtruth.txt").string(), trajectory);
+  writeTrajectory((root / "groundtruth.txt").string(), groundtruth);
 }
 
 } // namespace dynvo
