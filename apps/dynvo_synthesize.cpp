@@ -35,6 +35,18 @@ boundedInteger(const dynvo::app::Arguments& args,
   return value;
 }
 
+/// \throws dynvo::app::UsageError when the options are out of range
+void
+validate(const dynvo::SynthOptions& options)
+{
+  try {
+    options.validate();
+  }
+  catch (const std::invalid_argument& e) {
+    throw dynvo::app::UsageError(e.what());
+  }
+}
+
 /// -composite: the scenario's objects rendered into a real recording.
 int
 composite(const dynvo::app::Arguments& args)
@@ -56,12 +68,7 @@ composite(const dynvo::app::Arguments& args)
   if (args.has("frames"))
     composite.frames = static_cast<int>(boundedInteger(args, "frames", 0, 1, 1000000));
   options.intrinsics = composite.intrinsics;
-  try {
-    options.validate();
-  }
-  catch (const std::invalid_argument& e) {
-    throw dynvo::app::UsageError(e.what());
-  }
+  validate(options);
   const std::string out = args.string("out");
   pcl::console::TicToc timer;
   timer.tic();
@@ -155,12 +162,7 @@ main(int argc, char** argv)
         static_cast<int>(boundedInteger(args, "height", defaults.height, 8, 8192));
     const int threads =
         static_cast<int>(boundedInteger(args, "threads", hardware_threads, 1, 256));
-    try {
-      options.validate();
-    }
-    catch (const std::invalid_argument& e) {
-      throw dynvo::app::UsageError(e.what());
-    }
+    validate(options);
 
     const std::string out = args.string("out");
     pcl::console::TicToc timer;
