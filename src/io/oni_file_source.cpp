@@ -10,6 +10,7 @@
 
 #include <pcl/console/print.h>
 #include <pcl/io/openni2_grabber.h>
+#include <pcl/memory.h>
 
 #include <OpenNI.h>
 
@@ -114,7 +115,9 @@ struct OniFileSource::Impl {
   using DepthPtr = std::shared_ptr<const RawDepth>;
 
   std::string file;
-  std::unique_ptr<pcl::io::OpenNI2Grabber> grabber;
+  /// Made by pcl::make_shared (Eigen's aligned allocator, as PCL expects): created by
+  /// `new` in this C++17 file it was freed by libpcl_io's aligned operator delete.
+  std::shared_ptr<pcl::io::OpenNI2Grabber> grabber;
   CameraIntrinsics intrinsics;
   std::size_t depth_count = 0; ///< depth frames in the recording
   std::size_t color_count = 0; ///< colour frames in the recording
@@ -272,14 +275,15 @@ struct OniFileSource::Impl {
 };
 
 OniFileSource::OniFileSource(const std::string& file)
-    : impl_(std::make_unique<Impl>())
+    : file_(file)
+    , impl_(std::make_unique<Impl>())
 {
   impl_->file = file;
   checkOniHeader(file);
 
   Impl& impl = *impl_;
   try {
-    impl.grabber = std::make_unique<pcl::io::OpenNI2Grabber>(file);
+    impl.grabber = pcl::make_shared<pcl::io::OpenNI2Grabber>(file);
     auto device = impl.grabber->getDevice();
     if (!device || !device->isFile())
       fail(file + ": OpenNI2 did not open the file as a recording");

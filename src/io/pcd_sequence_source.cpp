@@ -1,4 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <dynvo/common/timestamps.h>
 #include <dynvo/io/pcd_sequence_source.h>
 
 #include <pcl/exceptions.h>
@@ -7,7 +8,9 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 
 namespace dynvo {
@@ -21,17 +24,60 @@ double
 stampFromName(const std::string& file)
 {
   const std::string stem = fs::path(file).stem().string();
-  std::size_t used = 0;
   double stamp = std::numeric_limits<double>::quiet_NaN();
-  try {
-    stamp = std::stod(stem, &used);
+  parseDecimal(stem, stamp);
+  return stamp;
+}
+
+/// The largest LZF expansion: a 3-byte back reference stands for at most 264 bytes.
+constexpr std::uint64_t LZF_MAX_EXPANSION = 88;
+
+/** Refuses a header that claims more data than the file can hold, or a frame over the
+ * limit, before PCL allocates anything for it (PCL trusts the header: a 0.3 MB file could
+ * make it allocate gigabytes). */
+void
+checkPcdHeader(const std::string& file,
+               const pcl::PCLPointCloud2& blob,
+               int data_type,
+               unsigned int data_index,
+               std::uint64_t max_pixels)
+{
+  checkFrameSize(file, blob.width, blob.height, max_pixels);
+  std::uint64_t point_bytes = 0, values = 0;
+  for (const pcl::PCLPointField& field : blob.fields) {
+    point_bytes += std::uint64_t{field.count} * pcl::getFieldSize(field.datatype);
+    values += field.count;
   }
-  catch (const std::exception&) {
-    used = 0;
+  std::error_code error;
+  const std::uint64_t size = fs::file_size(file, error);
+  if (error || data_index > size)
+    throw pcl::IOException(file + ": truncated PCD file (no data after the header)");
+  const std::uint64_t points = std::uint64_t{blob.width} * blob.height;
+  const std::uint64_t remaining = size - data_index;
+  const auto too_large = [&](std::uint64_t per_point, std::uint64_t available) {
+    return per_point == 0 || points > available / per_point;
+  };
+  const std::string claim = file + ": the header's " + std::to_string(points) +
+                            " points of " + std::to_string(point_bytes) + " bytes ";
+  if (data_type == 0 && too_large(values, remaining)) // at least a character per value
+    throw pcl::IOException(claim + "cannot be in the " + std::to_string(remaining) +
+                           " bytes of ASCII data (truncated or corrupt)");
+  if (data_type == 1 && too_large(point_bytes, remaining))
+    throw pcl::IOException(claim + "need more than the " + std::to_string(remaining) +
+                           " bytes of binary data (truncated or corrupt)");
+  if (data_type == 2) {
+    std::uint32_t sizes[2] = {0, 0}; // compressed, uncompressed
+    std::ifstream in(file, std::ios::binary);
+    in.seekg(data_index);
+    if (!in.read(reinterpret_cast<char*>(sizes), sizeof(sizes)) ||
+        sizes[0] > remaining - sizeof(sizes))
+      throw pcl::IOException(file + ": truncated compressed PCD data");
+    if (too_large(point_bytes, sizes[1]) || points * point_bytes != sizes[1] ||
+        sizes[1] > LZF_MAX_EXPANSION * std::uint64_t{sizes[0]})
+      throw pcl::IOException(claim + "disagree with the compressed block (" +
+                             std::to_string(sizes[0]) + " bytes for " +
+                             std::to_string(sizes[1]) + "; corrupt)");
   }
-  return used == stem.size() && std::isfinite(stamp)
-             ? stamp
-             : std::numeric_limits<double>::quiet_NaN();
 }
 
 } // namespace
@@ -75,8 +121,12 @@ naturalLess(const std::string& a, const std::string& b)
   return a < b;
 }
 
-PcdSequenceSource::PcdSequenceSource(const std::string& folder, double fps)
-    : fps_(fps)
+PcdSequenceSource::PcdSequenceSource(const std::string& folder,
+                                     double fps,
+                                     std::uint64_t max_frame_pixels)
+    : folder_(folder)
+    , fps_(fps)
+    , max_frame_pixels_(max_frame_pixels)
 {
   if (!(fps > 0.0) || !std::isfinite(fps))
     throw std::invalid_argument(
@@ -118,6 +168,7 @@ PcdSequenceSource::next(Frame& frame)
                         data_index) != 0 ||
       blob.fields.empty() || blob.width * blob.height == 0)
     throw pcl::IOException(file + ": cannot read PCD file (missing or corrupt header)");
+  checkPcdHeader(file, blob, data_type, data_index, max_frame_pixels_);
   if (reader.read(file, blob) != 0)
     throw pcl::IOException(file + ": cannot read PCD file (corrupt or truncated data)");
   if (blob.height <= 1)

@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <dynvo/io/partial_file.h>
 #include <dynvo/io/trajectory_io.h>
+#include <dynvo/common/timestamps.h>
 
 #include <pcl/exceptions.h>
 
@@ -10,6 +12,14 @@
 #include <sstream>
 
 namespace dynvo {
+
+namespace {
+
+/// Largest accepted magnitude of a stamp (s) or coordinate (m): far beyond any recording,
+/// small enough that squared errors summed over millions of poses stay finite.
+constexpr double MAX_MAGNITUDE = 1e15;
+
+} // namespace
 
 Trajectory
 readTrajectory(const std::string& path)
@@ -32,18 +42,13 @@ readTrajectory(const std::string& path)
     std::vector<double> values;
     std::string token;
     while (tokens >> token) {
-      std::size_t used = 0;
-      double value = NAN;
-      try {
-        value = std::stod(token, &used);
-      }
-      catch (const std::exception&) {
-        used = 0;
-      }
-      if (used != token.size())
-        throw pcl::IOException(where + "'" + token + "' is not a number");
-      if (!std::isfinite(value))
-        throw pcl::IOException(where + "value '" + token + "' is not finite");
+      double value = 0.0;
+      if (!parseDecimal(token, value))
+        throw pcl::IOException(where + "'" + token +
+                               "' is not a finite decimal number");
+      if (std::abs(value) > MAX_MAGNITUDE)
+        throw pcl::IOException(where + "value '" + token + "' is out of range (|v| <= " +
+                               std::to_string(MAX_MAGNITUDE) + ")");
       values.push_back(value);
     }
     if (values.size() != 8)
@@ -86,22 +91,10 @@ formatTumLine(const StampedPose& pose)
 void
 writeTrajectory(const std::string& path, const Trajectory& trajectory)
 {
-  const std::string partial = path + ".partial";
-  {
-    std::ofstream out(partial, std::ios::trunc);
-    if (!out)
-      throw pcl::IOException(path + ": cannot write trajectory file");
-    out << "# timestamp tx ty tz qx qy qz qw (camera-to-world, metres)\n";
-    for (const StampedPose& pose : trajectory)
-      out << formatTumLine(pose) << '\n';
-    if (!out.flush())
-      throw pcl::IOException(path + ": write failed");
-  }
-  std::error_code error;
-  std::filesystem::rename(partial, path, error);
-  if (error)
-    throw pcl::IOException(path + ": cannot move the written file into place (" +
-                           error.message() + ")");
+  std::string text = "# timestamp tx ty tz qx qy qz qw (camera-to-world, metres)\n";
+  for (const StampedPose& pose : trajectory)
+    text += formatTumLine(pose) + '\n';
+  replaceFile(path, text);
 }
 
 } // namespace dynvo
