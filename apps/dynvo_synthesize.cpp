@@ -17,22 +17,6 @@ const char* const USAGE =
     "dynvo_synthesize -out DIR [-scenario NAME] [-frames N] [-seed S] [-noise 0|1] "
     "[-threads N] [-width W -height H] | -list";
 
-/// Integer flag within [low, high]. \throws dynvo::app::UsageError otherwise
-long
-boundedInteger(const dynvo::app::Arguments& args,
-               const std::string& name,
-               long fallback,
-               long low,
-               long high)
-{
-  const long value = args.integer(name, fallback);
-  if (value < low || value > high)
-    throw dynvo::app::UsageError("-" + name + " must be in [" + std::to_string(low) +
-                                 ", " + std::to_string(high) + "], got " +
-                                 std::to_string(value));
-  return value;
-}
-
 } // namespace
 
 int
@@ -78,16 +62,16 @@ main(int argc, char** argv)
     dynvo::SynthOptions options;
     options.scenario = args.string("scenario", defaults.scenario);
     options.frames =
-        static_cast<int>(boundedInteger(args, "frames", defaults.frames, 1, 1000000));
+        static_cast<int>(args.integer("frames", defaults.frames, 1, 1000000));
     options.seed = static_cast<std::uint32_t>(
-        boundedInteger(args, "seed", defaults.seed, 0, 4294967295L));
-    options.noise = boundedInteger(args, "noise", defaults.noise ? 1 : 0, 0, 1) == 1;
+        args.integer("seed", defaults.seed, 0, 4294967295L));
+    options.noise = args.integer("noise", defaults.noise ? 1 : 0, 0, 1) == 1;
     options.width =
-        static_cast<int>(boundedInteger(args, "width", defaults.width, 8, 8192));
+        static_cast<int>(args.integer("width", defaults.width, 8, 8192));
     options.height =
-        static_cast<int>(boundedInteger(args, "height", defaults.height, 8, 8192));
+        static_cast<int>(args.integer("height", defaults.height, 8, 8192));
     const int threads =
-        static_cast<int>(boundedInteger(args, "threads", hardware_threads, 1, 256));
+        static_cast<int>(args.integer("threads", hardware_threads, 1, 256));
     try {
       options.validate();
     }

@@ -108,7 +108,7 @@ long
 Arguments::integer(const std::string& name, long fallback, long low, long high) const
 {
   const long value = integer(name, fallback);
-  if (value < low || value > high)
+  if (has(name) && (value < low || value > high))
     throw UsageError("-" + name + " must be in [" + std::to_string(low) + ", " +
                      std::to_string(high) + "], got " + std::to_string(value));
   return value;

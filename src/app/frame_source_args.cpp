@@ -104,9 +104,14 @@ processFrames(FrameSource& source,
   catch (const std::exception& e) {
     // Reader errors name their file already; anything else is about the frame in hand.
     end.error = shortenLongWords(where + errorMessage(e));
-    pcl::console::print_error("Error: %s (stopped after %zu frames; writing what they "
-                              "gave)\n",
-                              end.error.c_str(), end.frames);
+    if (end.frames == 0)
+      pcl::console::print_error("Error: %s (stopped at the first frame; no output "
+                                "is written or replaced)\n",
+                                end.error.c_str());
+    else
+      pcl::console::print_error("Error: %s (stopped after %zu frames; the outputs of "
+                                "those are written)\n",
+                                end.error.c_str(), end.frames);
   }
   return end;
 }

@@ -11,6 +11,8 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
+#include <vector>
 #include <limits>
 
 namespace dynvo {
@@ -32,51 +34,97 @@ stampFromName(const std::string& file)
 /// The largest LZF expansion: a 3-byte back reference stands for at most 264 bytes.
 constexpr std::uint64_t LZF_MAX_EXPANSION = 88;
 
+/// Longest PCD header read when looking for its DATA line (real headers are ~200 bytes).
+constexpr std::streamsize MAX_PCD_HEADER_BYTES = 64 * 1024;
+
 /** Refuses a header that claims more data than the file can hold, or a frame over the
- * limit, before PCL allocates anything for it (PCL trusts the header: a 0.3 MB file could
- * make it allocate gigabytes). */
+ * limit, before PCL reads it: PCL's readHeader() already allocates what the header claims
+ * (a 0.3 MB file could make it allocate gigabytes). */
 void
-checkPcdHeader(const std::string& file,
-               const pcl::PCLPointCloud2& blob,
-               int data_type,
-               unsigned int data_index,
-               std::uint64_t max_pixels)
+checkPcdHeader(const std::string& file, std::uint64_t max_pixels)
 {
-  checkFrameSize(file, blob.width, blob.height, max_pixels);
-  std::uint64_t point_bytes = 0, values = 0;
-  for (const pcl::PCLPointField& field : blob.fields) {
-    point_bytes += std::uint64_t{field.count} * pcl::getFieldSize(field.datatype);
-    values += field.count;
+  std::ifstream in(file, std::ios::binary);
+  if (!in)
+    throw pcl::IOException(file + ": cannot open PCD file");
+  const auto corrupt = [&file](const std::string& why) {
+    return pcl::IOException(file + ": corrupt PCD header (" + why + ")");
+  };
+  const auto number = [&](const std::string& token) {
+    if (token.empty() || token.find_first_not_of("0123456789") != std::string::npos ||
+        token.size() > 19)
+      throw corrupt("'" + token + "' is not a count");
+    return std::stoull(token);
+  };
+  std::vector<std::uint64_t> sizes, counts;
+  std::uint64_t width = 0, height = 0, points = 0;
+  std::string line, data;
+  while (data.empty() && std::getline(in, line)) {
+    if (in.tellg() > MAX_PCD_HEADER_BYTES)
+      throw corrupt("no DATA line in its first 64 KB");
+    std::istringstream tokens(line);
+    std::string key, token;
+    tokens >> key;
+    std::vector<std::uint64_t> values;
+    if (key == "SIZE" || key == "COUNT" || key == "WIDTH" || key == "HEIGHT" ||
+        key == "POINTS")
+      while (tokens >> token)
+        values.push_back(number(token));
+    if (key == "SIZE")
+      sizes = values;
+    else if (key == "COUNT")
+      counts = values;
+    else if (key == "WIDTH" || key == "HEIGHT" || key == "POINTS")
+      (key == "WIDTH" ? width : key == "HEIGHT" ? height : points) =
+          values.size() == 1 ? values[0] : 0;
+    else if (key == "DATA" && !(tokens >> data))
+      throw corrupt("DATA without a kind");
   }
+  if (data.empty())
+    throw corrupt("no DATA line");
+  if (width == 0 || height == 0 || width > UINT32_MAX || height > UINT32_MAX ||
+      points != width * height)
+    throw corrupt("WIDTH " + std::to_string(width) + " x HEIGHT " +
+                  std::to_string(height) + " must be POINTS " + std::to_string(points));
+  checkFrameSize(file, static_cast<std::uint32_t>(width),
+                 static_cast<std::uint32_t>(height), max_pixels);
+  if (!counts.empty() && counts.size() != sizes.size())
+    throw corrupt("SIZE and COUNT differ in length");
+  std::uint64_t point_bytes = 0, values = 0;
+  for (std::size_t f = 0; f < sizes.size(); ++f) {
+    const std::uint64_t count = counts.empty() ? 1 : counts[f];
+    if (sizes[f] > 8 || count > UINT32_MAX)
+      throw corrupt("field " + std::to_string(f) + " has SIZE " +
+                    std::to_string(sizes[f]) + " and COUNT " + std::to_string(count));
+    point_bytes += sizes[f] * count;
+    values += count;
+  }
+  const auto data_index = static_cast<std::uint64_t>(in.tellg());
   std::error_code error;
   const std::uint64_t size = fs::file_size(file, error);
   if (error || data_index > size)
     throw pcl::IOException(file + ": truncated PCD file (no data after the header)");
-  const std::uint64_t points = std::uint64_t{blob.width} * blob.height;
   const std::uint64_t remaining = size - data_index;
-  const auto too_large = [&](std::uint64_t per_point, std::uint64_t available) {
+  const auto too_large = [points](std::uint64_t per_point, std::uint64_t available) {
     return per_point == 0 || points > available / per_point;
   };
   const std::string claim = file + ": the header's " + std::to_string(points) +
                             " points of " + std::to_string(point_bytes) + " bytes ";
-  if (data_type == 0 && too_large(values, remaining)) // at least a character per value
+  if (data == "ascii" && too_large(values, remaining)) // a character per value at least
     throw pcl::IOException(claim + "cannot be in the " + std::to_string(remaining) +
                            " bytes of ASCII data (truncated or corrupt)");
-  if (data_type == 1 && too_large(point_bytes, remaining))
+  if (data == "binary" && too_large(point_bytes, remaining))
     throw pcl::IOException(claim + "need more than the " + std::to_string(remaining) +
                            " bytes of binary data (truncated or corrupt)");
-  if (data_type == 2) {
-    std::uint32_t sizes[2] = {0, 0}; // compressed, uncompressed
-    std::ifstream in(file, std::ios::binary);
-    in.seekg(data_index);
-    if (!in.read(reinterpret_cast<char*>(sizes), sizeof(sizes)) ||
-        sizes[0] > remaining - sizeof(sizes))
+  if (data == "binary_compressed") {
+    std::uint32_t block[2] = {0, 0}; // compressed, uncompressed size
+    if (!in.read(reinterpret_cast<char*>(block), sizeof(block)) ||
+        block[0] > remaining - sizeof(block))
       throw pcl::IOException(file + ": truncated compressed PCD data");
-    if (too_large(point_bytes, sizes[1]) || points * point_bytes != sizes[1] ||
-        sizes[1] > LZF_MAX_EXPANSION * std::uint64_t{sizes[0]})
+    if (too_large(point_bytes, block[1]) || points * point_bytes != block[1] ||
+        block[1] > LZF_MAX_EXPANSION * std::uint64_t{block[0]})
       throw pcl::IOException(claim + "disagree with the compressed block (" +
-                             std::to_string(sizes[0]) + " bytes for " +
-                             std::to_string(sizes[1]) + "; corrupt)");
+                             std::to_string(block[0]) + " bytes for " +
+                             std::to_string(block[1]) + "; corrupt)");
   }
 }
 
@@ -156,8 +204,9 @@ PcdSequenceSource::next(Frame& frame)
     return false;
   const std::string& file = files_[cursor_];
 
-  // PCL 1.13 dereferences garbage when a header has no fields or points, so the header
-  // is checked on its own first.
+  // PCL 1.13 allocates what the header claims and dereferences garbage when a header has
+  // no fields or points, so the header is checked on its own first.
+  checkPcdHeader(file, max_frame_pixels_);
   pcl::PCDReader reader;
   pcl::PCLPointCloud2 blob;
   Eigen::Vector4f origin;
@@ -168,7 +217,6 @@ PcdSequenceSource::next(Frame& frame)
                         data_index) != 0 ||
       blob.fields.empty() || blob.width * blob.height == 0)
     throw pcl::IOException(file + ": cannot read PCD file (missing or corrupt header)");
-  checkPcdHeader(file, blob, data_type, data_index, max_frame_pixels_);
   if (reader.read(file, blob) != 0)
     throw pcl::IOException(file + ": cannot read PCD file (corrupt or truncated data)");
   if (blob.height <= 1)

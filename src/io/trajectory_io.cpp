@@ -24,6 +24,9 @@ constexpr double MAX_MAGNITUDE = 1e15;
 Trajectory
 readTrajectory(const std::string& path)
 {
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error))
+    throw pcl::IOException(path + ": is a folder, not a trajectory file");
   std::ifstream in(path);
   if (!in)
     throw pcl::IOException(path + ": cannot open trajectory file");
@@ -47,8 +50,8 @@ readTrajectory(const std::string& path)
         throw pcl::IOException(where + "'" + token +
                                "' is not a finite decimal number");
       if (std::abs(value) > MAX_MAGNITUDE)
-        throw pcl::IOException(where + "value '" + token + "' is out of range (|v| <= " +
-                               std::to_string(MAX_MAGNITUDE) + ")");
+        throw pcl::IOException(where + "value '" + token +
+                               "' is out of range (magnitude above 1e15)");
       values.push_back(value);
     }
     if (values.size() != 8)

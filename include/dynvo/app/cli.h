@@ -57,7 +57,7 @@ public:
   /// The flag's value as an integer. \throws UsageError when it does not parse
   long integer(const std::string& name, long fallback) const;
 
-  /// The flag's value as an integer within [low, high].
+  /// The flag's value as an integer within [low, high] (the fallback is not checked).
   /// \throws UsageError when it does not parse or is out of range
   long integer(const std::string& name, long fallback, long low, long high) const;
 
