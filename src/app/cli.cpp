@@ -1,14 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <dynvo/app/cli.h>
+#include <dynvo/common/error_text.h>
 #include <dynvo/common/timestamps.h>
 
 #include <pcl/console/print.h>
-#include <pcl/exceptions.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <new>
 #include <sstream>
 
 namespace dynvo::app {
@@ -131,14 +130,7 @@ Arguments::optionsHelp() const
 std::string
 errorMessage(const std::exception& e)
 {
-  // PCLException::what() is "<function> in <file> @ <line> : <message>"; the message alone
-  // is what users need, and dynvo's messages already name the file they are about.
-  const std::string what = e.what();
-  if (dynamic_cast<const std::bad_alloc*>(&e))
-    return "out of memory (" + what + ")";
-  if (dynamic_cast<const pcl::PCLException*>(&e) && what.rfind(": ", 0) == 0)
-    return shortenLongWords(what.substr(2));
-  return shortenLongWords(what);
+  return shortenLongWords(errorText(e));
 }
 
 std::string

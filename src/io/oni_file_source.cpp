@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // OniFileSource: .oni playback through pcl::io::OpenNI2Grabber (stub without OpenNI2).
+#include <dynvo/common/error_text.h>
 #include <dynvo/io/oni_file_source.h>
 
 #include <pcl/exceptions.h>
@@ -161,7 +162,7 @@ struct OniFileSource::Impl {
       image->fillDepthImageRaw(depth->width, depth->height, depth->mm.data());
     }
     catch (const std::exception& failure) {
-      setError(file + ": cannot read a depth frame: " + failure.what());
+      setError(file + ": cannot read a depth frame: " + errorText(failure));
       return;
     }
     const auto no_sample = image->getNoSampleValue();
@@ -204,7 +205,7 @@ struct OniFileSource::Impl {
     catch (const std::exception& failure) {
       setError(file + ": cannot read a colour frame of " +
                std::to_string(frame->getWidth()) + "x" +
-               std::to_string(frame->getHeight()) + " px: " + failure.what());
+               std::to_string(frame->getHeight()) + " px: " + errorText(failure));
       return;
     }
 
@@ -350,7 +351,7 @@ OniFileSource::OniFileSource(const std::string& file)
   }
   catch (const std::exception& error) {
     impl.stop();
-    fail(file + ": cannot play the recording: " + error.what());
+    fail(file + ": cannot play the recording: " + errorText(error));
   }
   PCL_DEBUG("[dynvo::OniFileSource] %s: %zu depth and %zu colour frames\n",
             file.c_str(), impl.depth_count, impl.color_count);

@@ -74,8 +74,8 @@ private:
   bool help_ = false;
 };
 
-/// The message of an exception without PCLException's ": " prefix, "out of memory" for
-/// std::bad_alloc, long words shortened (see shortenLongWords()).
+/// errorText(e) (no PCLException location, "out of memory" for std::bad_alloc) with long
+/// words shortened (see shortenLongWords()).
 DYNVO_EXPORTS std::string errorMessage(const std::exception& e);
 
 /// The text with every word (run of non-blanks) over 200 characters cut to its first 120
