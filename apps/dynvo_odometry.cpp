@@ -71,7 +71,8 @@ pipelineOptions(const dynvo::app::Arguments& args)
   if (args.has("config"))
     dynvo::app::loadPipelineConfig(args.string("config"), options);
   options.intrinsics = dynvo::app::intrinsicsFromArguments(args);
-  options.threads = static_cast<unsigned>(args.integer("threads", options.threads, 1, 256));
+  options.threads =
+      static_cast<unsigned>(args.integer("threads", options.threads, 1, 256));
   options.segmentation.seed = static_cast<std::uint32_t>(
       args.integer("seed", options.segmentation.seed, 0, 4294967295L));
   if (args.has("no_segmentation"))

@@ -125,8 +125,9 @@ main(int argc, char** argv)
     estimation.setCameraIntrinsics(dynvo::app::intrinsicsFromArguments(args));
 
     const dynvo::FrameSource::Ptr source = dynvo::app::openFrameSource(args);
-    dynvo::app::prepareOutputs({{"-out", args.string("out")}, {"-png", args.string("png")}},
-                               source->inputPaths());
+    dynvo::app::prepareOutputs(
+        {{"-out", args.string("out")}, {"-png", args.string("png")}},
+        source->inputPaths());
     dynvo::Frame previous, current;
     for (long k = 0; k <= frame_index; ++k) {
       std::swap(previous, current);

@@ -63,13 +63,11 @@ main(int argc, char** argv)
     options.scenario = args.string("scenario", defaults.scenario);
     options.frames =
         static_cast<int>(args.integer("frames", defaults.frames, 1, 1000000));
-    options.seed = static_cast<std::uint32_t>(
-        args.integer("seed", defaults.seed, 0, 4294967295L));
+    options.seed =
+        static_cast<std::uint32_t>(args.integer("seed", defaults.seed, 0, 4294967295L));
     options.noise = args.integer("noise", defaults.noise ? 1 : 0, 0, 1) == 1;
-    options.width =
-        static_cast<int>(args.integer("width", defaults.width, 8, 8192));
-    options.height =
-        static_cast<int>(args.integer("height", defaults.height, 8, 8192));
+    options.width = static_cast<int>(args.integer("width", defaults.width, 8, 8192));
+    options.height = static_cast<int>(args.integer("height", defaults.height, 8, 8192));
     const int threads =
         static_cast<int>(args.integer("threads", hardware_threads, 1, 256));
     try {

@@ -107,11 +107,13 @@ expectRefusedUpFront(const CommandResult& result, const std::string& named)
 TEST_F(Reliability, SizeChangeMidRunKeepsWhatWasComputed)
 {
   const std::string seq = copy();
-  cv::imwrite(listed(seq, "rgb.txt", 6), cv::Mat(120, 200, CV_8UC3, cv::Scalar(9, 9, 9)));
-  cv::imwrite(listed(seq, "depth.txt", 6), cv::Mat(120, 200, CV_16UC1, cv::Scalar(5000)));
-  const auto result =
-      runCommand(ODOMETRY + " -tum_dir " + seq + " -out " + dir_.file("t.txt") +
-                 " -labels_dir " + dir_.file("labels") + " -objects " + dir_.file("o.txt"));
+  cv::imwrite(listed(seq, "rgb.txt", 6),
+              cv::Mat(120, 200, CV_8UC3, cv::Scalar(9, 9, 9)));
+  cv::imwrite(listed(seq, "depth.txt", 6),
+              cv::Mat(120, 200, CV_16UC1, cv::Scalar(5000)));
+  const auto result = runCommand(
+      ODOMETRY + " -tum_dir " + seq + " -out " + dir_.file("t.txt") + " -labels_dir " +
+      dir_.file("labels") + " -objects " + dir_.file("o.txt"));
   expectFailure(result, 1, listed(seq, "rgb.txt", 6));
   EXPECT_NE(result.err.find("frame size changed"), std::string::npos) << result.err;
   EXPECT_NE(result.err.find("stopped after 6 frames"), std::string::npos) << result.err;
@@ -125,10 +127,12 @@ TEST_F(Reliability, SizeChangeMidRunKeepsWhatWasComputed)
   // dynvo_segment takes a size change as a frame without flow (PCL's contract), so
   // a corrupt 7th image stops it instead.
   writeText(listed(seq, "rgb.txt", 6), "not a PNG");
-  const auto segment = runCommand(SEGMENT + " -tum_dir " + seq + " -out_dir " +
-                                  dir_.file("masks") + " -objects " + dir_.file("s.txt"));
+  const auto segment =
+      runCommand(SEGMENT + " -tum_dir " + seq + " -out_dir " + dir_.file("masks") +
+                 " -objects " + dir_.file("s.txt"));
   expectFailure(segment, 1, listed(seq, "rgb.txt", 6));
-  EXPECT_NE(segment.err.find("stopped after 6 frames"), std::string::npos) << segment.err;
+  EXPECT_NE(segment.err.find("stopped after 6 frames"), std::string::npos)
+      << segment.err;
   EXPECT_EQ(std::distance(fs::directory_iterator(dir_.file("masks")),
                           fs::directory_iterator()),
             6);
@@ -162,9 +166,9 @@ TEST_F(Reliability, OutputsOverInputsAreRefused)
   expectRefusedUpFront(
       runCommand(run + " -config " + config + " -write_config " + config), config);
   EXPECT_EQ(readText(config), written);
-  expectRefusedUpFront(runCommand(SEGMENT + " -tum_dir " + seq + " -out_dir " + seq +
-                                  "/depth"),
-                       seq + "/depth");
+  expectRefusedUpFront(
+      runCommand(SEGMENT + " -tum_dir " + seq + " -out_dir " + seq + "/depth"),
+      seq + "/depth");
   expectRefusedUpFront(runCommand(SCENE_FLOW + " -tum_dir " + seq + " -frame 1 -out " +
                                   seq + "/depth.txt"),
                        seq + "/depth.txt");
@@ -178,8 +182,8 @@ TEST_F(Reliability, FirstFrameFailureReplacesNothing)
   const std::string rgb = listed(seq, "rgb.txt", 0);
   fs::resize_file(rgb, fs::file_size(rgb) / 2);
   const std::string out = existing("t.txt"), objects = existing("o.txt");
-  const auto result =
-      runCommand(ODOMETRY + " -tum_dir " + seq + " -out " + out + " -objects " + objects);
+  const auto result = runCommand(ODOMETRY + " -tum_dir " + seq + " -out " + out +
+                                 " -objects " + objects);
   expectFailure(result, 1, rgb);
   EXPECT_NE(result.err.find("truncated PNG"), std::string::npos) << result.err;
   EXPECT_EQ(readText(out), KEEP);
@@ -220,11 +224,12 @@ writePcd(const TempDir& dir,
 {
   fs::create_directory(dir.file(name));
   const std::string file = dir.file(name) + "/0.pcd";
-  writeText(file, "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F "
-                  "U\nCOUNT " +
-                      count + "\nWIDTH " + width + "\nHEIGHT " + height +
-                      "\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " + points + "\nDATA " + data +
-                      "\n" + body);
+  writeText(file,
+            "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F "
+            "U\nCOUNT " +
+                count + "\nWIDTH " + width + "\nHEIGHT " + height +
+                "\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " + points + "\nDATA " + data +
+                "\n" + body);
   return file;
 }
 
@@ -242,31 +247,35 @@ TEST_F(Reliability, HugeHeadersAreRefusedBeforeAllocating)
   const std::string wide =
       writePcd(dir_, "wide", "1 1 1 1", "10000", "10000", "100000000", "binary", zeros);
   auto result = run(wide);
-  expectFailure(result, 1, wide + ": frame of 10000x10000 px is over the frame-size limit");
+  expectFailure(result, 1,
+                wide + ": frame of 10000x10000 px is over the frame-size limit");
   // Raising the limit lets the header through to the next check: the file size.
   result = run(wide, "-max_frame_pixels 100000000");
-  expectFailure(result, 1, wide + ": cannot read PCD file: the header's 100000000 points");
+  expectFailure(result, 1,
+                wide + ": cannot read PCD file: the header's 100000000 points");
   EXPECT_NE(result.err.find("need more than the 1000 bytes"), std::string::npos);
 
-  const std::string count =
-      writePcd(dir_, "count", "1 1 1 500000000", "640", "480", "307200", "binary", zeros);
+  const std::string count = writePcd(dir_, "count", "1 1 1 500000000", "640", "480",
+                                     "307200", "binary", zeros);
   expectFailure(run(count), 1, count + ": cannot read PCD file: the header's 307200");
-  const std::string compressed = writePcd(dir_, "compressed", "1 1 1 1", "4000", "4000",
-                                          "16000000", "binary_compressed",
-                                          std::string("\x10\0\0\0\0\0\0\x10", 8) + zeros);
+  const std::string compressed =
+      writePcd(dir_, "compressed", "1 1 1 1", "4000", "4000", "16000000",
+               "binary_compressed", std::string("\x10\0\0\0\0\0\0\x10", 8) + zeros);
   expectFailure(run(compressed), 1, compressed + ": cannot read PCD file");
   EXPECT_EQ(readText(out), KEEP);
 
   // A PNG whose header claims 10000x10000 px (IHDR only; never decoded).
   const std::string seq = copy();
   const std::string rgb = listed(seq, "rgb.txt", 0);
-  std::string png("\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR\0\0\x27\x10\0\0\x27\x10\x08\x02\0\0\0"
-                  "\0\0\0\0",
-                  33);
+  std::string png(
+      "\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR\0\0\x27\x10\0\0\x27\x10\x08\x02\0\0\0"
+      "\0\0\0\0",
+      33);
   png += std::string("\0\0\0\0IEND\xae\x42\x60\x82", 12);
   writeText(rgb, png);
   result = runCommand(ODOMETRY + " -tum_dir " + seq + " -out " + out);
-  expectFailure(result, 1, rgb + ": frame of 10000x10000 px is over the frame-size limit");
+  expectFailure(result, 1,
+                rgb + ": frame of 10000x10000 px is over the frame-size limit");
   EXPECT_EQ(readText(out), KEEP);
   expectFailure(runCommand(ODOMETRY + " -tum_dir " + seq + " -max_frame_pixels 0"), 2,
                 "-max_frame_pixels must be in [1,");
@@ -339,8 +348,7 @@ TEST_F(Reliability, MessagesNameTheFileAndTheProblem)
   writeText(dir_.file("one.txt"), "1 0 0 0 0 0 0 1\n");
   writeText(dir_.file("huge.txt"), "0 1e200 0 0 0 0 0 1\n1 0 0 0 0 0 0 1\n");
   const std::string gt = dir_.file("gt.txt");
-  for (const auto& [file, problem] :
-       std::vector<std::pair<std::string, std::string>>{
+  for (const auto& [file, problem] : std::vector<std::pair<std::string, std::string>>{
            {dir_.file("empty.txt"), ": holds 0 pose(s); at least 2 are needed"},
            {dir_.file("one.txt"), ": holds 1 pose(s); at least 2 are needed"},
            {dir_.file("labels"), ": is a folder, not a trajectory file"},

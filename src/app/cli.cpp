@@ -163,8 +163,7 @@ runApp(const std::string& usage, const std::function<int()>& body)
   }
   catch (const UsageError& e) {
     std::fprintf(stderr, "Error: %s\nUsage: %s\n(-h lists the options)\n",
-                 errorMessage(e).c_str(),
-                 usage.c_str());
+                 errorMessage(e).c_str(), usage.c_str());
     return 2;
   }
   catch (const std::exception& e) {

@@ -102,8 +102,8 @@ prepareOutputs(const std::vector<OutputPath>& outputs,
     std::error_code error;
     if (output.folder && !output.path.empty() &&
         !fs::create_directories(output.path, error) && error)
-      throw UsageError(output.flag + " " + output.path + ": cannot create the folder (" +
-                       error.message() + ")");
+      throw UsageError(output.flag + " " + output.path +
+                       ": cannot create the folder (" + error.message() + ")");
   }
 }
 

@@ -16,11 +16,10 @@ checkFrameSize(const std::string& name,
                std::uint64_t max_pixels)
 {
   if (std::uint64_t{width} * height > max_pixels)
-    throw pcl::IOException(name + ": frame of " + std::to_string(width) + "x" +
-                           std::to_string(height) +
-                           " px is over the frame-size limit of " +
-                           std::to_string(max_pixels) +
-                           " px (-max_frame_pixels raises it)");
+    throw pcl::IOException(
+        name + ": frame of " + std::to_string(width) + "x" + std::to_string(height) +
+        " px is over the frame-size limit of " + std::to_string(max_pixels) +
+        " px (-max_frame_pixels raises it)");
 }
 
 pcl::PointCloud<pcl::PointXYZRGB>::Ptr

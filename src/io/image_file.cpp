@@ -18,7 +18,8 @@ namespace {
 
 const unsigned char PNG_SIGNATURE[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
 /// The last 12 bytes of every complete PNG: the empty IEND chunk and its CRC.
-const unsigned char PNG_END[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D', 0xae, 0x42, 0x60, 0x82};
+const unsigned char PNG_END[12] = {0,   0,   0,    0,    'I',  'E',
+                                   'N', 'D', 0xae, 0x42, 0x60, 0x82};
 /// Signature (8) + IHDR length, type, width, height (16) + the rest of IHDR (9 + CRC 4).
 constexpr std::size_t PNG_MIN_SIZE = 8 + 25 + 12;
 
@@ -32,7 +33,9 @@ bigEndian32(const unsigned char* bytes)
 } // namespace
 
 cv::Mat
-readImageFile(const std::string& path, const std::string& what, std::uint64_t max_pixels)
+readImageFile(const std::string& path,
+              const std::string& what,
+              std::uint64_t max_pixels)
 {
   std::ifstream in(path, std::ios::binary);
   if (!in)

@@ -19,7 +19,8 @@ namespace dynvo {
  * \param[in] max_pixels frame-size limit (see checkFrameSize())
  * \throws pcl::IOException "<path>: <problem>"
  */
-cv::Mat
-readImageFile(const std::string& path, const std::string& what, std::uint64_t max_pixels);
+cv::Mat readImageFile(const std::string& path,
+                      const std::string& what,
+                      std::uint64_t max_pixels);
 
 } // namespace dynvo

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include <dynvo/io/label_io.h>
 #include <dynvo/io/frame.h>
+#include <dynvo/io/label_io.h>
 #include <dynvo/io/partial_file.h>
 
 #include "image_file.h"

@@ -47,7 +47,8 @@ checkPcdHeader(const std::string& file, std::uint64_t max_pixels)
   if (!in)
     throw pcl::IOException(file + ": cannot open PCD file");
   const auto corrupt = [&file](const std::string& why) {
-    return pcl::IOException(file + ": cannot read PCD file (corrupt header: " + why + ")");
+    return pcl::IOException(file + ": cannot read PCD file (corrupt header: " + why +
+                            ")");
   };
   const auto number = [&](const std::string& token) {
     if (token.empty() || token.find_first_not_of("0123456789") != std::string::npos ||
@@ -74,8 +75,9 @@ checkPcdHeader(const std::string& file, std::uint64_t max_pixels)
     else if (key == "COUNT")
       counts = values;
     else if (key == "WIDTH" || key == "HEIGHT" || key == "POINTS")
-      (key == "WIDTH" ? width : key == "HEIGHT" ? height : points) =
-          values.size() == 1 ? values[0] : 0;
+      (key == "WIDTH"    ? width
+       : key == "HEIGHT" ? height
+                         : points) = values.size() == 1 ? values[0] : 0;
     else if (key == "DATA" && !(tokens >> data))
       throw corrupt("DATA without a kind");
   }
@@ -102,15 +104,16 @@ checkPcdHeader(const std::string& file, std::uint64_t max_pixels)
   std::error_code error;
   const std::uint64_t size = fs::file_size(file, error);
   if (error || data_index > size)
-    throw pcl::IOException(file + ": cannot read PCD file (truncated: no data after the "
-                                  "header)");
+    throw pcl::IOException(file +
+                           ": cannot read PCD file (truncated: no data after the "
+                           "header)");
   const std::uint64_t remaining = size - data_index;
   const auto too_large = [points](std::uint64_t per_point, std::uint64_t available) {
     return per_point == 0 || points > available / per_point;
   };
   const std::string claim = file + ": cannot read PCD file: the header's " +
-                            std::to_string(points) +
-                            " points of " + std::to_string(point_bytes) + " bytes ";
+                            std::to_string(points) + " points of " +
+                            std::to_string(point_bytes) + " bytes ";
   if (data == "ascii" && too_large(values, remaining)) // a character per value at least
     throw pcl::IOException(claim + "cannot be in the " + std::to_string(remaining) +
                            " bytes of ASCII data (truncated or corrupt)");
@@ -121,7 +124,8 @@ checkPcdHeader(const std::string& file, std::uint64_t max_pixels)
     std::uint32_t block[2] = {0, 0}; // compressed, uncompressed size
     if (!in.read(reinterpret_cast<char*>(block), sizeof(block)) ||
         block[0] > remaining - sizeof(block))
-      throw pcl::IOException(file + ": cannot read PCD file (truncated compressed data)");
+      throw pcl::IOException(file +
+                             ": cannot read PCD file (truncated compressed data)");
     if (too_large(point_bytes, block[1]) || points * point_bytes != block[1] ||
         block[1] > LZF_MAX_EXPANSION * std::uint64_t{block[0]})
       throw pcl::IOException(claim + "disagree with the compressed block (" +

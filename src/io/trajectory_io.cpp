@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <dynvo/common/timestamps.h>
 #include <dynvo/io/partial_file.h>
 #include <dynvo/io/trajectory_io.h>
-#include <dynvo/common/timestamps.h>
 
 #include <pcl/exceptions.h>
 

@@ -168,11 +168,12 @@ TumFolderSource::TumFolderSource(const std::string& folder, const Options& optio
          associateTimestamps(rgb_stamps, depth_stamps, options_.max_difference))
       entries_.push_back({rgb[i].stamp, rgb[i].file, depth[j].stamp, depth[j].file});
     if (entries_.size() < rgb.size())
-      PCL_WARN("[dynvo::TumFolderSource] %s: %zu of %zu colour images have no depth "
-               "image within %g s (duplicate, out-of-order or distant stamps in rgb.txt "
-               "or depth.txt); those frames are skipped\n",
-               folder.c_str(), rgb.size() - entries_.size(), rgb.size(),
-               options_.max_difference);
+      PCL_WARN(
+          "[dynvo::TumFolderSource] %s: %zu of %zu colour images have no depth "
+          "image within %g s (duplicate, out-of-order or distant stamps in rgb.txt "
+          "or depth.txt); those frames are skipped\n",
+          folder.c_str(), rgb.size() - entries_.size(), rgb.size(),
+          options_.max_difference);
   }
   if (entries_.empty())
     fail(folder + ": no colour image has a depth image within " +
@@ -209,7 +210,8 @@ TumFolderSource::read(std::size_t i) const
   frame.timestamp = entry.rgb_stamp;
   frame.name = (dir / entry.rgb_file).string();
   frame.color = readColor(dir / entry.rgb_file, options_.max_frame_pixels);
-  frame.depth = readDepth(dir / entry.depth_file, depth_scale_, options_.max_frame_pixels);
+  frame.depth =
+      readDepth(dir / entry.depth_file, depth_scale_, options_.max_frame_pixels);
   if (frame.color.width != frame.depth.width ||
       frame.color.height != frame.depth.height)
     fail((dir / entry.depth_file).string() + ": depth image size differs from " +

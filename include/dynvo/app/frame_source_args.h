@@ -39,8 +39,9 @@ struct FrameLoopEnd {
  * so that the app still writes what was computed and then exits 1.
  * \param[in] max_frames frames to process at most (0 = all)
  */
-DYNVO_EXPORTS FrameLoopEnd processFrames(FrameSource& source,
-                                         std::size_t max_frames,
-                                         const std::function<void(const Frame&)>& process);
+DYNVO_EXPORTS FrameLoopEnd
+processFrames(FrameSource& source,
+              std::size_t max_frames,
+              const std::function<void(const Frame&)>& process);
 
 } // namespace dynvo::app
