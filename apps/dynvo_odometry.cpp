@@ -191,7 +191,7 @@ main(int argc, char** argv)
 
     auto source = dynvo::app::openFrameSource(args);
     auto inputs = source->inputPaths();
-    inputs.insert(inputs.end(), {args.string("config"), groundtruth_path});
+    inputs.push_back(args.string("config"));
     dynvo::app::prepareOutputs({{"-out", args.string("out")},
                                 {"-labels_dir", args.string("labels_dir"), true},
                                 {"-objects", args.string("objects")},

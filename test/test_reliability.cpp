@@ -172,6 +172,12 @@ TEST_F(Reliability, OutputsOverInputsAreRefused)
   expectRefusedUpFront(runCommand(SCENE_FLOW + " -tum_dir " + seq + " -frame 1 -out " +
                                   seq + "/depth.txt"),
                        seq + "/depth.txt");
+  // The ground truth is part of the recording even for an app that does not read it.
+  expectRefusedUpFront(runCommand(SEGMENT + " -tum_dir " + seq + " -out_dir " +
+                                  dir_.file("masks") + " -objects " + seq +
+                                  "/groundtruth.txt"),
+                       seq + "/groundtruth.txt");
+  EXPECT_EQ(readText(seq + "/groundtruth.txt"), groundtruth);
   EXPECT_EQ(readText(rgb), first_rgb);
 }
 
@@ -209,6 +215,13 @@ TEST_F(Reliability, OutputPathsAreCheckedUpFront)
   EXPECT_EQ(readText(out), KEEP);
   EXPECT_FALSE(fs::exists(out + ".partial"));
   EXPECT_FALSE(fs::exists(dir_.file("missing")));
+
+  // A file may go into an output folder the run creates.
+  const auto inside = runCommand(run + " -labels_dir " + dir_.file("new") + " -out " +
+                                 dir_.file("new/t.txt"));
+  EXPECT_EQ(inside.exit_code, 0) << inside.err;
+  EXPECT_EQ(dynvo::readTrajectory(dir_.file("new/t.txt")).size(),
+            static_cast<std::size_t>(FRAMES));
 }
 
 /// A PCD file with the given header lines and data bytes, in its own folder.

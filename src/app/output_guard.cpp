@@ -39,9 +39,10 @@ writable(const fs::path& folder)
   return ::access(folder.c_str(), W_OK) == 0;
 }
 
-/// Why the output cannot be written ("" when it can).
+/// Why the output cannot be written ("" when it can); a file may go into one of the
+/// output folders that prepareOutputs() creates.
 std::string
-problem(const OutputPath& output)
+problem(const OutputPath& output, const std::vector<OutputPath>& outputs)
 {
   std::error_code error;
   const fs::path path(output.path);
@@ -58,6 +59,13 @@ problem(const OutputPath& output)
   if (fs::exists(status) && !fs::is_regular_file(status))
     return "is not a regular file";
   const fs::path parent = path.has_parent_path() ? path.parent_path() : fs::path(".");
+  const bool made =
+      std::any_of(outputs.begin(), outputs.end(), [&](const OutputPath& o) {
+        return o.folder && !o.path.empty() &&
+               resolved(o.path) == resolved(parent.string());
+      });
+  if (made)
+    return "";
   if (!fs::is_directory(parent, error))
     return "folder '" + parent.string() + "' does not exist";
   if (!writable(parent))
@@ -82,7 +90,7 @@ prepareOutputs(const std::vector<OutputPath>& outputs,
     if (output.path.empty())
       continue;
     const std::string where = output.flag + " " + output.path + ": ";
-    const std::string why = problem(output);
+    const std::string why = problem(output, outputs);
     if (!why.empty())
       throw UsageError(where + why);
     const fs::path path = resolved(output.path);

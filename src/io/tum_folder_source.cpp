@@ -189,7 +189,8 @@ TumFolderSource::inputPaths() const
 {
   const fs::path dir(folder_);
   std::vector<std::string> paths;
-  for (const char* index : {"rgb.txt", "depth.txt", "associations.txt"})
+  for (const char* index :
+       {"rgb.txt", "depth.txt", "associations.txt", "groundtruth.txt"})
     if (fs::exists(dir / index))
       paths.push_back((dir / index).string());
   for (const Entry& entry : entries_)

@@ -45,7 +45,7 @@ public:
 
   std::size_t size() const override { return entries_.size(); }
 
-  /// The index files read and the folders holding the listed images.
+  /// The index files, groundtruth.txt (when present) and the folders of the listed images.
   std::vector<std::string> inputPaths() const override;
 
   /// The associated pairs, in time order.
