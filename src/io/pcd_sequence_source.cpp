@@ -65,20 +65,24 @@ checkPcdHeader(const std::string& file, std::uint64_t max_pixels)
     std::istringstream tokens(line);
     std::string key, token;
     tokens >> key;
+    // PCL matches a key by its first letters ("SIZEs" is SIZE), so this does too.
+    const auto is = [&key](const char* name) {
+      return key.rfind(name, 0) == 0;
+    };
+    const bool counted = is("WIDTH") || is("HEIGHT") || is("POINTS");
     std::vector<std::uint64_t> values;
-    if (key == "SIZE" || key == "COUNT" || key == "WIDTH" || key == "HEIGHT" ||
-        key == "POINTS")
+    if (is("SIZE") || is("COUNT") || counted)
       while (tokens >> token)
         values.push_back(number(token));
-    if (key == "SIZE")
+    if (is("SIZE"))
       sizes = values;
-    else if (key == "COUNT")
+    else if (is("COUNT"))
       counts = values;
-    else if (key == "WIDTH" || key == "HEIGHT" || key == "POINTS")
-      (key == "WIDTH"    ? width
-       : key == "HEIGHT" ? height
-                         : points) = values.size() == 1 ? values[0] : 0;
-    else if (key == "DATA" && !(tokens >> data))
+    else if (counted)
+      (is("WIDTH")    ? width
+       : is("HEIGHT") ? height
+                      : points) = values.size() == 1 ? values[0] : 0;
+    else if (is("DATA") && !(tokens >> data))
       throw corrupt("DATA without a kind");
   }
   if (data.empty())
@@ -108,19 +112,23 @@ checkPcdHeader(const std::string& file, std::uint64_t max_pixels)
                            ": cannot read PCD file (truncated: no data after the "
                            "header)");
   const std::uint64_t remaining = size - data_index;
+  // PCL's classification: any other DATA kind is read as ASCII.
+  const bool compressed = data.rfind("binary_compressed", 0) == 0;
+  const bool binary = !compressed && data.rfind("binary", 0) == 0;
   const auto too_large = [points](std::uint64_t per_point, std::uint64_t available) {
     return per_point == 0 || points > available / per_point;
   };
   const std::string claim = file + ": cannot read PCD file: the header's " +
                             std::to_string(points) + " points of " +
                             std::to_string(point_bytes) + " bytes ";
-  if (data == "ascii" && too_large(values, remaining)) // a character per value at least
+  if (!binary && !compressed &&
+      too_large(values, remaining)) // a character per value at least
     throw pcl::IOException(claim + "cannot be in the " + std::to_string(remaining) +
                            " bytes of ASCII data (truncated or corrupt)");
-  if (data == "binary" && too_large(point_bytes, remaining))
+  if (binary && too_large(point_bytes, remaining))
     throw pcl::IOException(claim + "need more than the " + std::to_string(remaining) +
                            " bytes of binary data (truncated or corrupt)");
-  if (data == "binary_compressed") {
+  if (compressed) {
     std::uint32_t block[2] = {0, 0}; // compressed, uncompressed size
     if (!in.read(reinterpret_cast<char*>(block), sizeof(block)) ||
         block[0] > remaining - sizeof(block))
@@ -228,16 +236,27 @@ PcdSequenceSource::next(Frame& frame)
   if (blob.height <= 1)
     throw pcl::IOException(file + ": cloud is not organized (height " +
                            std::to_string(blob.height) + ")");
-  const auto has_field = [&](const std::string& name) {
-    return std::any_of(blob.fields.begin(), blob.fields.end(),
-                       [&](const pcl::PCLPointField& f) {
-                         return f.name == name;
-                       });
+  const auto field = [&](const std::string& name) -> const pcl::PCLPointField* {
+    const auto found = std::find_if(blob.fields.begin(), blob.fields.end(),
+                                    [&](const pcl::PCLPointField& f) {
+                                      return f.name == name;
+                                    });
+    return found == blob.fields.end() ? nullptr : &*found;
   };
-  if (!has_field("x") || !has_field("y") || !has_field("z"))
+  if (!field("x") || !field("y") || !field("z"))
     throw pcl::IOException(file + ": cloud has no x, y, z fields");
-  if (!has_field("rgb") && !has_field("rgba"))
+  const pcl::PCLPointField* colour = field("rgb") ? field("rgb") : field("rgba");
+  if (!colour)
     throw pcl::IOException(file + ": cloud has no rgb or rgba field");
+  // pcl::fromPCLPointCloud2 copies 4 bytes for each of these whatever the header declares,
+  // so a smaller field would be read past the data (found by fuzz_pcd_header).
+  for (const pcl::PCLPointField* f : {field("x"), field("y"), field("z"), colour})
+    if (pcl::getFieldSize(f->datatype) != 4 || f->count != 1 ||
+        std::uint64_t{f->offset} + 4 > blob.point_step)
+      throw pcl::IOException(file + ": field '" + f->name +
+                             "' must hold one 4-byte value (SIZE 4, COUNT 1)");
+  if (blob.data.size() < std::uint64_t{blob.point_step} * blob.width * blob.height)
+    throw pcl::IOException(file + ": cannot read PCD file (less data than points)");
 
   Frame out;
   out.name = file;
