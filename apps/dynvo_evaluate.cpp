@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <stdexcept>
 #include <string>
 
 namespace {
@@ -99,8 +100,15 @@ main(int argc, char** argv)
     else if (unit != "s")
       throw dynvo::app::UsageError("-delta_unit must be s or f, got '" + unit + "'");
 
-    const auto groundtruth = dynvo::readTrajectory(args.positional()[0]);
-    const auto estimate = dynvo::readTrajectory(args.positional()[1]);
+    const auto read = [](const std::string& path) {
+      auto trajectory = dynvo::readTrajectory(path);
+      if (trajectory.size() < 2)
+        throw std::runtime_error(path + ": holds " + std::to_string(trajectory.size()) +
+                                 " pose(s); at least 2 are needed");
+      return trajectory;
+    };
+    const auto groundtruth = read(args.positional()[0]);
+    const auto estimate = read(args.positional()[1]);
     const dynvo::RpeResult rpe = dynvo::computeRpe(groundtruth, estimate, options);
     const dynvo::AteResult ate = dynvo::computeAte(groundtruth, estimate);
     std::printf("%s\n", dynvo::formatMetrics(rpe, ate, args.has("json")).c_str());

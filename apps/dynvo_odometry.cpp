@@ -3,6 +3,7 @@
 #include <dynvo/app/cli.h>
 #include <dynvo/app/frame_source_args.h>
 #include <dynvo/app/odometry_pipeline.h>
+#include <dynvo/app/output_guard.h>
 #include <dynvo/app/pipeline_config.h>
 #include <dynvo/app/run_report.h>
 #include <dynvo/eval/trajectory_metrics.h>
@@ -16,11 +17,10 @@
 #endif
 
 #include <pcl/console/print.h>
-#include <pcl/exceptions.h>
 
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
+#include <limits>
 
 namespace {
 
@@ -71,12 +71,10 @@ pipelineOptions(const dynvo::app::Arguments& args)
   if (args.has("config"))
     dynvo::app::loadPipelineConfig(args.string("config"), options);
   options.intrinsics = dynvo::app::intrinsicsFromArguments(args);
-  const long threads = args.integer("threads", options.threads);
-  const long seed = args.integer("seed", options.segmentation.seed);
-  if (threads < 1 || seed < 0)
-    throw UsageError("-threads must be >= 1 and -seed >= 0");
-  options.threads = static_cast<unsigned>(threads);
-  options.segmentation.seed = static_cast<std::uint32_t>(seed);
+  options.threads =
+      static_cast<unsigned>(args.integer("threads", options.threads, 1, 256));
+  options.segmentation.seed = static_cast<std::uint32_t>(
+      args.integer("seed", options.segmentation.seed, 0, 4294967295L));
   if (args.has("no_segmentation"))
     options.use_segmentation = false;
   const std::string refine = args.string("refine", "none");
@@ -104,8 +102,6 @@ public:
       throw UsageError("-render_every must be >= 1");
 #ifdef DYNVO_WITH_VTK
     params_.intrinsics = intrinsics;
-    if (!dir_.empty())
-      fs::create_directories(dir_);
 #else
     (void)intrinsics;
     if (!dir_.empty())
@@ -174,13 +170,14 @@ main(int argc, char** argv)
       pcl::console::setVerbosityLevel(pcl::console::L_ERROR);
     const auto options = pipelineOptions(args);
     if (args.has("write_config")) {
-      dynvo::app::writePipelineConfig(args.string("write_config"), options);
-      std::printf("wrote %s\n", args.string("write_config").c_str());
+      const std::string path = args.string("write_config");
+      dynvo::app::prepareOutputs({{"-write_config", path}}, {args.string("config")});
+      dynvo::app::writePipelineConfig(path, options);
+      std::printf("wrote %s\n", path.c_str());
       return 0;
     }
-    const long max_frames = args.integer("max_frames", 0);
-    if (max_frames < 0)
-      throw UsageError("-max_frames must be >= 0");
+    const long max_frames =
+        args.integer("max_frames", 0, 0, std::numeric_limits<long>::max());
 
     const std::string groundtruth_path =
         args.has("tum_dir")
@@ -193,6 +190,13 @@ main(int argc, char** argv)
       throw UsageError("-init_gt needs a -tum_dir folder with groundtruth.txt");
 
     auto source = dynvo::app::openFrameSource(args);
+    auto inputs = source->inputPaths();
+    inputs.push_back(args.string("config"));
+    dynvo::app::prepareOutputs({{"-out", args.string("out")},
+                                {"-labels_dir", args.string("labels_dir"), true},
+                                {"-objects", args.string("objects")},
+                                {"-render_dir", args.string("render_dir"), true}},
+                               inputs);
     dynvo::app::RunOutputs outputs(args.string("out"), args.string("labels_dir"),
                                    args.string("objects"),
                                    args.has("init_gt") ? &groundtruth : nullptr);
@@ -201,29 +205,19 @@ main(int argc, char** argv)
     dynvo::app::RunReport report(max_frames > 0
                                      ? std::min<std::size_t>(max_frames, source->size())
                                      : source->size());
-    dynvo::Frame frame;
-    int status = 0;
-    try {
-      while (
-          (max_frames == 0 || report.frames() < static_cast<std::size_t>(max_frames)) &&
-          source->next(frame)) {
-        const auto& result = pipeline.process(frame.cloud, frame.timestamp);
-        outputs.add(result);
-        renderer.add(frame, result, outputs.trajectory());
-        report.add(result);
-      }
-    }
-    catch (const pcl::PCLException& e) {
-      // Keep everything computed so far: the outputs are still written below.
-      pcl::console::print_error("Error: %s (stopping after %zu frames)\n",
-                                dynvo::app::errorMessage(e).c_str(), report.frames());
-      status = 1;
-    }
+    // Whatever stops the run, what was computed is written below.
+    const auto end = dynvo::app::processFrames(
+        *source, static_cast<std::size_t>(max_frames), [&](const dynvo::Frame& frame) {
+          const auto& result = pipeline.process(frame.cloud, frame.timestamp);
+          outputs.add(result);
+          renderer.add(frame, result, outputs.trajectory());
+          report.add(result);
+        });
     outputs.finish();
     renderer.finish(outputs.trajectory(), groundtruth);
     report.printSummary(groundtruth.empty() ? ""
                                             : dynvo::app::RunReport::accuracy(
                                                   groundtruth, outputs.trajectory()));
-    return status;
+    return end.error.empty() ? 0 : 1;
   });
 }

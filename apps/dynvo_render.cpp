@@ -2,6 +2,7 @@
 // dynvo_render: label-coloured PNGs of a finished run, and its trajectory plot.
 #include <dynvo/app/cli.h>
 #include <dynvo/app/frame_source_args.h>
+#include <dynvo/app/output_guard.h>
 #include <dynvo/common/timestamps.h>
 #include <dynvo/eval/trajectory_metrics.h>
 #include <dynvo/io/label_io.h>
@@ -20,6 +21,7 @@
 #include <numeric>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 namespace {
 
@@ -169,6 +171,12 @@ main(int argc, char** argv)
         args.has("groundtruth") ? dynvo::readTrajectory(args.string("groundtruth"))
                                 : dynvo::Trajectory{};
     const auto source = dynvo::app::openFrameSource(args);
+    const fs::path out_dir = args.string("out_dir");
+    const fs::path labels_dir = args.string("labels_dir");
+    auto inputs = source->inputPaths();
+    inputs.insert(inputs.end(), {args.string("trajectory"), args.string("groundtruth"),
+                                 labels_dir.string()});
+    dynvo::app::prepareOutputs({{"-out_dir", out_dir.string(), true}}, inputs);
     std::string reason;
     if (!dynvo::displayAvailable(&reason)) {
       pcl::console::print_warn(
@@ -177,45 +185,46 @@ main(int argc, char** argv)
           reason.c_str());
       return 0;
     }
-    const fs::path out_dir = args.string("out_dir");
-    fs::create_directories(out_dir);
-    const fs::path labels_dir = args.string("labels_dir");
 
     std::vector<double> stamps;
     for (const auto& pose : estimate)
       stamps.push_back(pose.timestamp);
     dynvo::LabelRenderer renderer;
     std::vector<double> render_ms;
-    dynvo::Frame frame;
-    for (long index = 0; source->next(frame); ++index) {
-      if (frames.empty() ? index % every != 0 : frames.count(index) == 0)
-        continue;
-      const std::string stamp = dynvo::formatStamp(frame.timestamp);
-      const std::size_t k =
-          estimate.empty() ? 0 : dynvo::findClosestIndex(stamps, frame.timestamp);
-      const auto labels =
-          readLabels((labels_dir / (stamp + ".png")).string(), *frame.cloud);
-      if (estimate.empty() ||
-          std::abs(stamps[k] - frame.timestamp) > POSE_STAMP_TOLERANCE ||
-          labels.empty()) {
-        pcl::console::print_warn(
-            "Frame %ld (%s): no %s; skipped.\n", index, stamp.c_str(),
-            labels.empty() ? "label PNG" : "pose in the trajectory");
-        continue;
-      }
-      if (frame.cloud->isOrganized()) {
-        params.width = frame.cloud->width;
-        params.height = frame.cloud->height;
-      }
-      renderer.setParameters(params);
-      const dynvo::Trajectory so_far(estimate.begin(), estimate.begin() + k + 1);
-      pcl::console::TicToc timer;
-      timer.tic();
-      if (!renderer.render(*frame.cloud, labels, estimate[k].T_world_camera, so_far,
-                           (out_dir / (stamp + "_" + view + ".png")).string()))
-        return 1;
-      render_ms.push_back(timer.toc());
-    }
+    long index = -1;
+    // Whatever stops the run, the frames rendered stay and the plot is still drawn.
+    const auto end =
+        dynvo::app::processFrames(*source, 0, [&](const dynvo::Frame& frame) {
+          ++index;
+          if (frames.empty() ? index % every != 0 : frames.count(index) == 0)
+            return;
+          const std::string stamp = dynvo::formatStamp(frame.timestamp);
+          const std::size_t k =
+              estimate.empty() ? 0 : dynvo::findClosestIndex(stamps, frame.timestamp);
+          const auto labels =
+              readLabels((labels_dir / (stamp + ".png")).string(), *frame.cloud);
+          if (estimate.empty() ||
+              std::abs(stamps[k] - frame.timestamp) > POSE_STAMP_TOLERANCE ||
+              labels.empty()) {
+            pcl::console::print_warn(
+                "Frame %ld (%s): no %s; skipped.\n", index, stamp.c_str(),
+                labels.empty() ? "label PNG" : "pose in the trajectory");
+            return;
+          }
+          if (frame.cloud->isOrganized()) {
+            params.width = frame.cloud->width;
+            params.height = frame.cloud->height;
+          }
+          renderer.setParameters(params);
+          const dynvo::Trajectory so_far(estimate.begin(), estimate.begin() + k + 1);
+          const std::string image = (out_dir / (stamp + "_" + view + ".png")).string();
+          pcl::console::TicToc timer;
+          timer.tic();
+          if (!renderer.render(*frame.cloud, labels, estimate[k].T_world_camera, so_far,
+                               image))
+            throw std::runtime_error(image + ": rendering failed");
+          render_ms.push_back(timer.toc());
+        });
     if (!groundtruth.empty())
       estimate = dynvo::alignToGroundTruth(groundtruth, estimate);
     if (!estimate.empty() &&
@@ -224,6 +233,6 @@ main(int argc, char** argv)
       return 1;
 
     printSummary(render_ms, out_dir.string());
-    return 0;
+    return end.error.empty() ? 0 : 1;
   });
 }

@@ -2,6 +2,8 @@
 // dynvo_scene_flow: grid scene flow between frames I-1 and I of a recording, saved as PCD.
 #include <dynvo/app/cli.h>
 #include <dynvo/app/frame_source_args.h>
+#include <dynvo/app/output_guard.h>
+#include <dynvo/io/partial_file.h>
 #include <dynvo/scene_flow/grid_scene_flow_estimation.h>
 
 #include <pcl/console/print.h>
@@ -47,8 +49,10 @@ writeTrackImage(const std::string& path,
     cv::line(image, c, cv::Point2f(f.prev_u, f.prev_v), colour, 1, cv::LINE_AA);
     cv::circle(image, c, 2, colour, cv::FILLED, cv::LINE_AA);
   }
-  if (!cv::imwrite(path, image))
-    throw std::runtime_error("cannot write " + path);
+  std::vector<std::uint8_t> png;
+  if (!cv::imencode(".png", image, png))
+    throw std::runtime_error(path + ": cannot encode the track image");
+  dynvo::replaceFile(path, std::string(png.begin(), png.end()));
 }
 
 } // namespace
@@ -121,6 +125,9 @@ main(int argc, char** argv)
     estimation.setCameraIntrinsics(dynvo::app::intrinsicsFromArguments(args));
 
     const dynvo::FrameSource::Ptr source = dynvo::app::openFrameSource(args);
+    dynvo::app::prepareOutputs(
+        {{"-out", args.string("out")}, {"-png", args.string("png")}},
+        source->inputPaths());
     dynvo::Frame previous, current;
     for (long k = 0; k <= frame_index; ++k) {
       std::swap(previous, current);
@@ -139,7 +146,10 @@ main(int argc, char** argv)
       throw std::runtime_error("no flow between " + previous.name + " and " +
                                current.name);
 
-    pcl::io::savePCDFileBinary(args.string("out"), flow);
+    dynvo::PartialFile pcd(args.string("out"));
+    if (pcl::io::savePCDFileBinary(pcd.partialPath(), flow) != 0)
+      throw std::runtime_error(pcd.path() + ": cannot write the flow PCD");
+    pcd.commit();
     if (args.has("png"))
       writeTrackImage(args.string("png"), current.color, flow);
     const auto count = [&](auto member) {

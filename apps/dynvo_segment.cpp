@@ -2,7 +2,9 @@
 // dynvo_segment: per-pixel rigid-motion labels of an RGB-D sequence (scene flow + segmentation).
 #include <dynvo/app/cli.h>
 #include <dynvo/app/frame_source_args.h>
+#include <dynvo/app/output_guard.h>
 #include <dynvo/io/label_io.h>
+#include <dynvo/io/partial_file.h>
 #include <dynvo/motion_segmentation/rigid_motion_segmentation.h>
 #include <dynvo/scene_flow/grid_scene_flow_estimation.h>
 
@@ -15,6 +17,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -65,22 +69,23 @@ main(int argc, char** argv)
       pcl::console::setVerbosityLevel(pcl::console::L_ERROR);
     if (!args.has("out_dir"))
       throw dynvo::app::UsageError("-out_dir DIR is required");
-    const long max_frames = args.integer("max_frames", -1);
-    const long threads = args.integer("threads", hardware_threads);
-    const long seed = args.integer("seed", defaults.seed);
-    if (threads < 1 || seed < 0 || seed > 4294967295L || max_frames == 0 ||
-        max_frames < -1)
-      throw dynvo::app::UsageError(
-          "-threads must be >= 1, -seed in [0, 2^32), -max_frames >= 1");
+    const long max_frames =
+        args.integer("max_frames", 0, 1, std::numeric_limits<long>::max());
+    const long threads = args.integer("threads", hardware_threads, 1, 256);
+    const long seed = args.integer("seed", defaults.seed, 0, 4294967295L);
 
     const dynvo::CameraIntrinsics intrinsics =
         dynvo::app::intrinsicsFromArguments(args);
     const dynvo::FrameSource::Ptr source = dynvo::app::openFrameSource(args);
     const std::filesystem::path out_dir = args.string("out_dir");
-    std::filesystem::create_directories(out_dir);
+    dynvo::app::prepareOutputs(
+        {{"-out_dir", out_dir.string(), true}, {"-objects", args.string("objects")}},
+        source->inputPaths());
+    std::unique_ptr<dynvo::PartialFile> objects_file;
     std::ofstream objects;
     if (args.has("objects")) {
-      objects.open(args.string("objects"));
+      objects_file = std::make_unique<dynvo::PartialFile>(args.string("objects"));
+      objects.open(objects_file->partialPath());
       if (!objects)
         throw pcl::IOException(args.string("objects") + ": cannot write objects file");
     }
@@ -97,44 +102,54 @@ main(int argc, char** argv)
 
     pcl::PointCloud<dynvo::PointFlow>::Ptr flow(new pcl::PointCloud<dynvo::PointFlow>);
     std::vector<pcl::PointIndices> segments;
-    dynvo::Frame frame;
     pcl::console::TicToc timer;
     double segment_ms = 0.0;
     long count = 0;
-    for (; (max_frames < 0 || count < max_frames) && source->next(frame); ++count) {
-      flow_estimation.shiftCurrentToPrevious();
-      flow_estimation.setInputCloud(frame.cloud);
-      const std::string path =
-          (out_dir / dynvo::stampedPngName(frame.timestamp)).string();
-      if (count == 0) {
-        dynvo::writeLabelImage(path, dynvo::paintLabelImage({}, {}, frame.cloud->width,
-                                                            frame.cloud->height));
-        continue;
-      }
-      flow_estimation.compute(*flow);
-      segmentation.setInputCloud(frame.cloud);
-      segmentation.setInputFlow(flow);
-      timer.tic();
-      segmentation.segment(segments);
-      segment_ms += timer.toc();
-      dynvo::writeLabelImage(
-          path, dynvo::paintLabelImage(segments, segmentation.getSegmentLabels(),
-                                       frame.cloud->width, frame.cloud->height));
-      if (segments.empty())
-        continue;
-      // Constant-velocity prediction for the next frame (identity until a background exists).
-      if (!segments[0].indices.empty())
-        segmentation.setPredictedMotion(segmentation.getMotions()[0]);
-      for (std::size_t s = 1; s < segments.size() && objects; ++s)
-        objects << dynvo::formatObjectMotionLine(
-                       frame.timestamp, segmentation.getSegmentLabels()[s],
-                       segments[s].indices.size(), segmentation.getMotions()[s])
-                << '\n';
+    // Whatever stops the run, the labels and objects of the frames done are kept.
+    const auto end = dynvo::app::processFrames(
+        *source, static_cast<std::size_t>(max_frames), [&](const dynvo::Frame& frame) {
+          flow_estimation.shiftCurrentToPrevious();
+          flow_estimation.setInputCloud(frame.cloud);
+          const std::string path =
+              (out_dir / dynvo::stampedPngName(frame.timestamp)).string();
+          if (count++ == 0) {
+            dynvo::writeLabelImage(path,
+                                   dynvo::paintLabelImage({}, {}, frame.cloud->width,
+                                                          frame.cloud->height));
+            return;
+          }
+          flow_estimation.compute(*flow);
+          segmentation.setInputCloud(frame.cloud);
+          segmentation.setInputFlow(flow);
+          timer.tic();
+          segmentation.segment(segments);
+          segment_ms += timer.toc();
+          dynvo::writeLabelImage(
+              path, dynvo::paintLabelImage(segments, segmentation.getSegmentLabels(),
+                                           frame.cloud->width, frame.cloud->height));
+          if (segments.empty())
+            return;
+          // Constant-velocity prediction for the next frame (identity until a
+          // background exists).
+          if (!segments[0].indices.empty())
+            segmentation.setPredictedMotion(segmentation.getMotions()[0]);
+          for (std::size_t s = 1; s < segments.size() && objects; ++s)
+            objects << dynvo::formatObjectMotionLine(
+                           frame.timestamp, segmentation.getSegmentLabels()[s],
+                           segments[s].indices.size(), segmentation.getMotions()[s])
+                    << '\n';
+        });
+    count = static_cast<long>(end.frames);
+    if (objects_file && count > 0) {
+      objects.close();
+      if (!objects)
+        throw pcl::IOException(args.string("objects") + ": write failed");
+      objects_file->commit();
     }
     pcl::console::print_highlight("Labelled %ld frames into %s; segmentation ", count,
                                   out_dir.string().c_str());
     pcl::console::print_value("%.2f", count > 1 ? segment_ms / (count - 1) : 0.0);
     pcl::console::print_info(" ms per frame\n");
-    return 0;
+    return end.error.empty() ? 0 : 1;
   });
 }

@@ -2,6 +2,7 @@
 // dynvo_synthesize: writes a deterministic synthetic dynamic-scene RGB-D sequence (TUM layout).
 #include <dynvo/app/cli.h>
 #include <dynvo/app/frame_source_args.h>
+#include <dynvo/app/output_guard.h>
 #include <dynvo/synth/scene_synthesizer.h>
 
 #include <pcl/console/print.h>
@@ -18,22 +19,6 @@ const char* const USAGE =
     "dynvo_synthesize -out DIR [-scenario NAME] [-frames N] [-seed S] [-clean] "
     "[-threads N] [-width W -height H] | -composite TUM_DIR -scenario NAME -out DIR "
     "[-frames N] [-seed S] [-camera C] [-fx -fy -cx -cy] [-depth_scale S] | -list";
-
-/// Integer flag within [low, high]. \throws dynvo::app::UsageError otherwise
-long
-boundedInteger(const dynvo::app::Arguments& args,
-               const std::string& name,
-               long fallback,
-               long low,
-               long high)
-{
-  const long value = args.integer(name, fallback);
-  if (value < low || value > high)
-    throw dynvo::app::UsageError("-" + name + " must be in [" + std::to_string(low) +
-                                 ", " + std::to_string(high) + "], got " +
-                                 std::to_string(value));
-  return value;
-}
 
 /// \throws dynvo::app::UsageError when the options are out of range
 void
@@ -57,8 +42,8 @@ composite(const dynvo::app::Arguments& args)
                                    " does not apply to -composite");
   dynvo::SynthOptions options;
   options.scenario = args.string("scenario", options.scenario);
-  options.seed = static_cast<std::uint32_t>(
-      boundedInteger(args, "seed", options.seed, 0, 4294967295L));
+  options.seed =
+      static_cast<std::uint32_t>(args.integer("seed", options.seed, 0, 4294967295L));
   dynvo::CompositeOptions composite;
   composite.recording = args.string("composite");
   composite.intrinsics = dynvo::app::intrinsicsFromArguments(args);
@@ -66,10 +51,11 @@ composite(const dynvo::app::Arguments& args)
   if (args.has("depth_scale") && !(composite.depth_scale > 0.0))
     throw dynvo::app::UsageError("-depth_scale must be positive");
   if (args.has("frames"))
-    composite.frames = static_cast<int>(boundedInteger(args, "frames", 0, 1, 1000000));
+    composite.frames = static_cast<int>(args.integer("frames", 0, 1, 1000000));
   options.intrinsics = composite.intrinsics;
   validate(options);
   const std::string out = args.string("out");
+  dynvo::app::prepareOutputs({{"-out", out, true}}, {composite.recording});
   pcl::console::TicToc timer;
   timer.tic();
   try {
@@ -152,16 +138,14 @@ main(int argc, char** argv)
     dynvo::SynthOptions options;
     options.scenario = args.string("scenario", defaults.scenario);
     options.frames =
-        static_cast<int>(boundedInteger(args, "frames", defaults.frames, 1, 1000000));
-    options.seed = static_cast<std::uint32_t>(
-        boundedInteger(args, "seed", defaults.seed, 0, 4294967295L));
+        static_cast<int>(args.integer("frames", defaults.frames, 1, 1000000));
+    options.seed =
+        static_cast<std::uint32_t>(args.integer("seed", defaults.seed, 0, 4294967295L));
     options.noise = !args.has("clean");
-    options.width =
-        static_cast<int>(boundedInteger(args, "width", defaults.width, 8, 8192));
-    options.height =
-        static_cast<int>(boundedInteger(args, "height", defaults.height, 8, 8192));
+    options.width = static_cast<int>(args.integer("width", defaults.width, 8, 8192));
+    options.height = static_cast<int>(args.integer("height", defaults.height, 8, 8192));
     const int threads =
-        static_cast<int>(boundedInteger(args, "threads", hardware_threads, 1, 256));
+        static_cast<int>(args.integer("threads", hardware_threads, 1, 256));
     validate(options);
 
     const std::string out = args.string("out");

@@ -8,7 +8,7 @@ BUILD="${DYNVO_BUILD_DIR:-$ROOT/build}"
 # Debian 12 packages dynvo needs (see README.md).
 PACKAGES=(cmake ninja-build g++ libpcl-dev pcl-tools libopencv-dev libvtk9-dev
           libeigen3-dev libflann-dev libgtest-dev libbenchmark-dev libopenni2-dev
-          libopenni-dev xvfb xauth)
+          libopenni-dev xvfb xauth clang)
 
 say() { printf '\n==> %s\n' "$*"; }
 

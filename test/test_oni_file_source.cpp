@@ -3,6 +3,7 @@
 // make_oni_fixture (test/tools), plus the error paths.
 #include "support/temp_dir.h"
 
+#include <dynvo/common/error_text.h>
 #include <dynvo/io/oni_file_source.h>
 
 #include <pcl/exceptions.h>
@@ -45,7 +46,8 @@ expectedColor(int k, int u, int v, std::uint8_t* rgb)
   rgb[2] = static_cast<std::uint8_t>(v / 2);
 }
 
-/// Expects `call` to throw pcl::IOException whose message names `file`.
+/// Expects `call` to throw pcl::IOException whose message, as apps print it, names `file`
+/// and carries no PCL function signature or source location.
 template <typename Call>
 void
 expectIOExceptionNaming(const std::string& file, Call call)
@@ -55,8 +57,12 @@ expectIOExceptionNaming(const std::string& file, Call call)
     ADD_FAILURE() << "no exception for " << file;
   }
   catch (const pcl::IOException& error) {
-    EXPECT_NE(std::string(error.what()).find(file), std::string::npos)
-        << "message does not name the file: " << error.what();
+    const std::string shown = dynvo::errorText(error);
+    EXPECT_NE(shown.find(file), std::string::npos)
+        << "message does not name the file: " << shown;
+    EXPECT_EQ(shown.find(" @ "), std::string::npos) << shown;
+    EXPECT_EQ(shown.find("pcl::"), std::string::npos) << shown;
+    EXPECT_EQ(shown.find('\n'), std::string::npos) << shown;
   }
   catch (const std::exception& error) {
     ADD_FAILURE() << "wrong exception type for " << file << ": " << error.what();

@@ -127,6 +127,32 @@ TEST(PcdSequenceSource, BadInputNamesTheFile)
   pcl::PointCloud<pcl::PointXYZ> no_colour(5, 4, pcl::PointXYZ(0.f, 0.f, 1.f));
   ASSERT_EQ(pcl::io::savePCDFileBinary(dir.file("c.pcd"), no_colour), 0);
   expect_next_fails("c.pcd", "no rgb");
+
+  // 1-byte y, z and rgb: PCL's conversion would copy 4 bytes each, past the data (the
+  // first finding of fuzz_pcd_header, under ASan a heap-buffer-overflow).
+  dynvo::test::writeText(dir.file("s.pcd"),
+                         "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z rgb\nSIZE 4 1 1 1\n"
+                         "WIDTH 2\nHEIGHT 2\nPOINTS 4\nDATA ascii\n0 0 1 2\n0 0 1 "
+                         "2\n0 0 1 2\n0 0 1 2\n");
+  expect_next_fails("s.pcd", "field 'y' must hold one 4-byte value");
+
+  // A header claiming more data than the file holds is refused before PCL allocates it.
+  dynvo::test::writeText(dir.file("h.pcd"),
+                         "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\n"
+                         "TYPE F F F U\nCOUNT 1 1 1 1\nWIDTH 640\nHEIGHT 480\n"
+                         "POINTS 307200\nDATA binary\n0123456789");
+  expect_next_fails("h.pcd", "need more than the 10 bytes of binary data");
+  dynvo::test::writeText(dir.file("w.pcd"),
+                         "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\n"
+                         "WIDTH 5000\nHEIGHT 5000\nPOINTS 25000000\nDATA binary\n");
+  expect_next_fails("w.pcd", "over the frame-size limit of 16777216 px");
+  // PCL reads an unknown DATA kind as ASCII and allocates COUNT values per point first
+  // (fuzz_pcd_header: out of memory).
+  dynvo::test::writeText(dir.file("k.pcd"),
+                         "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\n"
+                         "TYPE F F F U\nCOUNT 777777771 1 1 1\nWIDTH 2\nHEIGHT 2\n"
+                         "POINTS 4\nDATA icsai\n0 0 1 255\n");
+  expect_next_fails("k.pcd", "cannot be in the 10 bytes of ASCII data");
 }
 
 } // namespace

@@ -3,6 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
+#include <utility>
+#include <vector>
+
 namespace {
 
 using Pairs = std::vector<std::pair<std::size_t, std::size_t>>;
@@ -48,6 +52,29 @@ TEST(FindClosestIndex, MatchesTheBenchmarkSearch)
   EXPECT_EQ(dynvo::findClosestIndex(stamps, 2.4), 2u);
   EXPECT_EQ(dynvo::findClosestIndex(stamps, 2.6), 3u);
   EXPECT_EQ(dynvo::findClosestIndex(stamps, 40.0), 4u);
+}
+
+TEST(ParseDecimal, PlainDecimalsOnly)
+{
+  double value = -7.0;
+  for (const auto& [text, expected] : std::vector<std::pair<std::string, double>>{
+           {"1305031102.175304", 1305031102.175304},
+           {"-1.5", -1.5},
+           {"+2", 2.0},
+           {".5", 0.5},
+           {"3.", 3.0},
+           {"1e3", 1000.0},
+           {"2.5E-1", 0.25}}) {
+    EXPECT_TRUE(dynvo::parseDecimal(text, value)) << text;
+    EXPECT_DOUBLE_EQ(value, expected) << text;
+  }
+  // std::stod takes the first five; the rest are malformed or out of range.
+  for (const std::string text : {"0x1p3", "inf", "nan", "-infinity", " 1", "1 ", "1.5s",
+                                 "", ".", "e3", "1e", "1e+", "--1", "1e999", "1.2.3"}) {
+    value = -7.0;
+    EXPECT_FALSE(dynvo::parseDecimal(text, value)) << text;
+    EXPECT_EQ(value, -7.0) << text;
+  }
 }
 
 } // namespace

@@ -78,8 +78,11 @@ TEST(TrajectoryIo, EveryViolationNamesFileAndLine)
 {
   expectReadError("1 0 0 0 0 0 0 1\n2 0 0 0 0 0 1\n", 2, "expected 8 numbers");
   expectReadError("# c\n1 0 0 0 0 0 0 1 5\n", 2, "expected 8 numbers");
-  expectReadError("1 0 0 x 0 0 0 1\n", 1, "'x' is not a number");
-  expectReadError("1 0 0 nan 0 0 0 1\n", 1, "not finite");
+  expectReadError("1 0 0 x 0 0 0 1\n", 1, "'x' is not a finite decimal number");
+  expectReadError("1 0 0 nan 0 0 0 1\n", 1, "'nan' is not a finite decimal number");
+  expectReadError("0x1p3 0 0 0 0 0 0 1\n", 1, "'0x1p3' is not a finite decimal number");
+  // Squares of such values overflow the metrics (dynvo_evaluate printed inf).
+  expectReadError("1 1e200 0 0 0 0 0 1\n", 1, "'1e200' is out of range");
   expectReadError("1 0 0 0 0 0 0 1\n\n1 0 0 0 0 0 0 1\n", 3, "does not increase");
   expectReadError("1 0 0 0 0 0 0 1\n0.5 0 0 0 0 0 0 1\n", 2, "does not increase");
   expectReadError("1 0 0 0 0 0 0 0.9\n", 1, "quaternion norm");

@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <dynvo/app/cli.h>
+#include <dynvo/common/error_text.h>
+#include <dynvo/common/timestamps.h>
 
 #include <pcl/console/print.h>
-#include <pcl/exceptions.h>
 
 #include <algorithm>
 #include <cmath>
@@ -77,15 +78,8 @@ Arguments::number(const std::string& name, double fallback) const
   if (!has(name))
     return fallback;
   const std::string text = string(name);
-  std::size_t used = 0;
-  double value = NAN;
-  try {
-    value = std::stod(text, &used);
-  }
-  catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != text.size() || !std::isfinite(value))
+  double value = 0.0;
+  if (!parseDecimal(text, value))
     throw UsageError("option '-" + name + "' expects a number, got '" + text + "'");
   return value;
 }
@@ -109,6 +103,16 @@ Arguments::integer(const std::string& name, long fallback) const
   return value;
 }
 
+long
+Arguments::integer(const std::string& name, long fallback, long low, long high) const
+{
+  const long value = integer(name, fallback);
+  if (has(name) && (value < low || value > high))
+    throw UsageError("-" + name + " must be in [" + std::to_string(low) + ", " +
+                     std::to_string(high) + "], got " + std::to_string(value));
+  return value;
+}
+
 std::string
 Arguments::optionsHelp() const
 {
@@ -126,12 +130,29 @@ Arguments::optionsHelp() const
 std::string
 errorMessage(const std::exception& e)
 {
-  // PCLException::what() is "<function> in <file> @ <line> : <message>"; the message alone
-  // is what users need, and dynvo's messages already name the file they are about.
-  const std::string what = e.what();
-  if (dynamic_cast<const pcl::PCLException*>(&e) && what.rfind(": ", 0) == 0)
-    return what.substr(2);
-  return what;
+  return shortenLongWords(errorText(e));
+}
+
+std::string
+shortenLongWords(const std::string& text)
+{
+  constexpr std::size_t LONGEST = 200, HEAD = 120, TAIL = 40;
+  std::string out;
+  std::size_t start = 0;
+  while (start < text.size()) {
+    const std::size_t blank = text.find_first_of(" \t\n", start);
+    const std::size_t end = blank == std::string::npos ? text.size() : blank;
+    const std::size_t length = end - start;
+    if (length > LONGEST)
+      out += text.substr(start, HEAD) + "...(" + std::to_string(length) +
+             " characters)..." + text.substr(end - TAIL, TAIL);
+    else
+      out += text.substr(start, length);
+    if (end < text.size())
+      out += text[end];
+    start = end + 1;
+  }
+  return out;
 }
 
 int
@@ -141,8 +162,8 @@ runApp(const std::string& usage, const std::function<int()>& body)
     return body();
   }
   catch (const UsageError& e) {
-    std::fprintf(stderr, "Error: %s\nUsage: %s\n(-h lists the options)\n", e.what(),
-                 usage.c_str());
+    std::fprintf(stderr, "Error: %s\nUsage: %s\n(-h lists the options)\n",
+                 errorMessage(e).c_str(), usage.c_str());
     return 2;
   }
   catch (const std::exception& e) {

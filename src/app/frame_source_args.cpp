@@ -4,6 +4,11 @@
 #include <dynvo/io/pcd_sequence_source.h>
 #include <dynvo/io/tum_folder_source.h>
 
+#include <pcl/console/print.h>
+
+#include <cstdint>
+#include <limits>
+
 namespace dynvo::app {
 
 std::vector<Option>
@@ -25,6 +30,9 @@ frameSourceOptions()
        "raw depth units per metre (default: 5000 TUM, 1000 associations.txt)"},
       {"fps", "HZ",
        "frame rate for PCD files whose names are not timestamps (default 30)"},
+      {"max_frame_pixels", "N",
+       "refuse larger frames before reading them (default " +
+           std::to_string(DEFAULT_MAX_FRAME_PIXELS) + " = 4096x4096)"},
   };
 }
 
@@ -57,20 +65,55 @@ openFrameSource(const Arguments& args)
   const int given = args.has("tum_dir") + args.has("pcd_dir") + args.has("oni");
   if (given != 1)
     throw UsageError("give exactly one of -tum_dir, -pcd_dir, -oni");
+  const auto max_pixels = static_cast<std::uint64_t>(
+      args.integer("max_frame_pixels", static_cast<long>(DEFAULT_MAX_FRAME_PIXELS), 1,
+                   std::numeric_limits<long>::max()));
   if (args.has("pcd_dir")) {
     const double fps = args.number("fps", 30.0);
     if (!(fps > 0.0))
       throw UsageError("-fps must be positive");
-    return std::make_unique<PcdSequenceSource>(args.string("pcd_dir"), fps);
+    return std::make_unique<PcdSequenceSource>(args.string("pcd_dir"), fps, max_pixels);
   }
   if (args.has("oni"))
     return std::make_unique<OniFileSource>(args.string("oni"));
   TumFolderSource::Options options;
   options.intrinsics = intrinsicsFromArguments(args);
   options.depth_scale = args.number("depth_scale", 0.0);
+  options.max_frame_pixels = max_pixels;
   if (args.has("depth_scale") && !(options.depth_scale > 0.0))
     throw UsageError("-depth_scale must be positive");
   return std::make_unique<TumFolderSource>(args.string("tum_dir"), options);
+}
+
+FrameLoopEnd
+processFrames(FrameSource& source,
+              std::size_t max_frames,
+              const std::function<void(const Frame&)>& process)
+{
+  FrameLoopEnd end;
+  std::string where; // the frame in hand, once it has been read
+  try {
+    Frame frame;
+    while ((max_frames == 0 || end.frames < max_frames) && source.next(frame)) {
+      where = frame.name + ": ";
+      process(frame);
+      where.clear();
+      ++end.frames;
+    }
+  }
+  catch (const std::exception& e) {
+    // Reader errors name their file already; anything else is about the frame in hand.
+    end.error = shortenLongWords(where + errorMessage(e));
+    if (end.frames == 0)
+      pcl::console::print_error("Error: %s (stopped at the first frame; no output "
+                                "is written or replaced)\n",
+                                end.error.c_str());
+    else
+      pcl::console::print_error("Error: %s (stopped after %zu frames; the outputs of "
+                                "those are written)\n",
+                                end.error.c_str(), end.frames);
+  }
+  return end;
 }
 
 } // namespace dynvo::app

@@ -239,7 +239,10 @@ OdometryPipeline::process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& clo
   Impl& p = *impl_;
   if (!cloud || !cloud->isOrganized())
     throw std::invalid_argument(
-        "[dynvo::app::OdometryPipeline::process] the frame must be an organized cloud");
+        "[dynvo::app::OdometryPipeline::process] the frame must be an organized cloud "
+        "(2 rows or more), got " +
+        (cloud ? std::to_string(cloud->width) + "x" + std::to_string(cloud->height)
+               : std::string("none")));
   if (p.previous &&
       (cloud->width != p.previous->width || cloud->height != p.previous->height))
     throw std::invalid_argument(

@@ -3,6 +3,7 @@
 #include <dynvo/common/timestamps.h>
 #include <dynvo/eval/trajectory_metrics.h>
 #include <dynvo/io/label_io.h>
+#include <dynvo/io/partial_file.h>
 
 #include <pcl/exceptions.h>
 
@@ -28,12 +29,6 @@ median(std::vector<double> values)
   return *middle;
 }
 
-std::string
-partial(const std::string& path)
-{
-  return path + ".partial";
-}
-
 } // namespace
 
 RunOutputs::RunOutputs(const std::string& trajectory_path,
@@ -52,7 +47,8 @@ RunOutputs::RunOutputs(const std::string& trajectory_path,
       throw pcl::IOException(labels_dir_ + ": cannot create the labels folder");
   }
   if (!objects_path_.empty()) {
-    objects_.open(partial(objects_path_), std::ios::trunc);
+    objects_file_ = std::make_unique<PartialFile>(objects_path_);
+    objects_.open(objects_file_->partialPath(), std::ios::trunc);
     if (!objects_)
       throw pcl::IOException(objects_path_ + ": cannot write objects file");
     objects_ << "# timestamp id n_pixels tx ty tz qx qy qz qw (T_curr_prev, metres)\n";
@@ -91,15 +87,16 @@ RunOutputs::add(const FrameResult& result)
 void
 RunOutputs::finish()
 {
+  // Nothing computed: every existing file stays as it was (the partial file goes).
+  if (trajectory_.empty())
+    return;
   if (!trajectory_path_.empty())
     writeTrajectory(trajectory_path_, trajectory_);
-  if (objects_.is_open()) {
+  if (objects_file_) {
     objects_.close();
-    std::error_code error;
-    fs::rename(partial(objects_path_), objects_path_, error);
-    if (error)
-      throw pcl::IOException(objects_path_ +
-                             ": cannot move the written file into place");
+    if (!objects_)
+      throw pcl::IOException(objects_path_ + ": write failed");
+    objects_file_->commit();
   }
 }
 

@@ -2,11 +2,52 @@
 #include <dynvo/common/timestamps.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <numeric>
+#include <stdexcept>
 #include <tuple>
 
 namespace dynvo {
+
+bool
+parseDecimal(const std::string& token, double& value)
+{
+  const auto digits = [&token](std::size_t& i) {
+    const std::size_t start = i;
+    while (i < token.size() && std::isdigit(static_cast<unsigned char>(token[i])))
+      ++i;
+    return i - start;
+  };
+  std::size_t i = 0;
+  if (i < token.size() && (token[i] == '+' || token[i] == '-'))
+    ++i;
+  std::size_t mantissa = digits(i);
+  if (i < token.size() && token[i] == '.')
+    mantissa += digits(++i);
+  if (mantissa == 0)
+    return false;
+  if (i < token.size() && (token[i] == 'e' || token[i] == 'E')) {
+    if (++i < token.size() && (token[i] == '+' || token[i] == '-'))
+      ++i;
+    if (digits(i) == 0)
+      return false;
+  }
+  if (i != token.size())
+    return false;
+  std::size_t used = 0;
+  double parsed = 0.0;
+  try {
+    parsed = std::stod(token, &used);
+  }
+  catch (const std::exception&) {
+    return false; // out of range
+  }
+  if (used != token.size() || !std::isfinite(parsed))
+    return false;
+  value = parsed;
+  return true;
+}
 
 std::vector<std::pair<std::size_t, std::size_t>>
 associateTimestamps(const std::vector<double>& first,

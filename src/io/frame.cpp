@@ -1,11 +1,26 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <dynvo/io/frame.h>
 
+#include <pcl/exceptions.h>
+
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 
 namespace dynvo {
+
+void
+checkFrameSize(const std::string& name,
+               std::uint32_t width,
+               std::uint32_t height,
+               std::uint64_t max_pixels)
+{
+  if (std::uint64_t{width} * height > max_pixels)
+    throw pcl::IOException(
+        name + ": frame of " + std::to_string(width) + "x" + std::to_string(height) +
+        " px is over the frame-size limit of " + std::to_string(max_pixels) +
+        " px (-max_frame_pixels raises it)");
+}
 
 pcl::PointCloud<pcl::PointXYZRGB>::Ptr
 makeOrganizedCloud(const ColorImage& color,

@@ -1,5 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <dynvo/io/frame.h>
 #include <dynvo/io/label_io.h>
+#include <dynvo/io/partial_file.h>
+
+#include "image_file.h"
 
 #include <pcl/exceptions.h>
 
@@ -47,23 +51,21 @@ writeLabelImage(const std::string& path, const LabelImage& labels)
     throw pcl::IOException(path + ": label image data does not match its size");
   const cv::Mat image(static_cast<int>(labels.height), static_cast<int>(labels.width),
                       CV_8UC1, const_cast<std::uint8_t*>(labels.data.data()));
-  bool written = false;
+  std::vector<std::uint8_t> png;
   try {
-    written = cv::imwrite(path, image);
+    if (!cv::imencode(".png", image, png))
+      throw pcl::IOException(path + ": cannot encode label image");
   }
   catch (const cv::Exception& e) {
-    throw pcl::IOException(path + ": cannot write label image (" + e.err + ")");
+    throw pcl::IOException(path + ": cannot encode label image (" + e.err + ")");
   }
-  if (!written)
-    throw pcl::IOException(path + ": cannot write label image");
+  replaceFile(path, std::string(png.begin(), png.end()));
 }
 
 LabelImage
 readLabelImage(const std::string& path)
 {
-  const cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
-  if (image.empty())
-    throw pcl::IOException(path + ": cannot read label image (missing or corrupt)");
+  const cv::Mat image = readImageFile(path, "label image", DEFAULT_MAX_FRAME_PIXELS);
   if (image.type() != CV_8UC1)
     throw pcl::IOException(path + ": label image must be 8-bit single channel");
   LabelImage labels;

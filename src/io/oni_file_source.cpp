@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // OniFileSource: .oni playback through pcl::io::OpenNI2Grabber (stub without OpenNI2).
+#include <dynvo/common/error_text.h>
 #include <dynvo/io/oni_file_source.h>
 
 #include <pcl/exceptions.h>
@@ -10,6 +11,7 @@
 
 #include <pcl/console/print.h>
 #include <pcl/io/openni2_grabber.h>
+#include <pcl/memory.h>
 
 #include <OpenNI.h>
 
@@ -114,7 +116,9 @@ struct OniFileSource::Impl {
   using DepthPtr = std::shared_ptr<const RawDepth>;
 
   std::string file;
-  std::unique_ptr<pcl::io::OpenNI2Grabber> grabber;
+  /// Made by pcl::make_shared (Eigen's aligned allocator, as PCL expects): created by
+  /// `new` in this C++17 file it was freed by libpcl_io's aligned operator delete.
+  std::shared_ptr<pcl::io::OpenNI2Grabber> grabber;
   CameraIntrinsics intrinsics;
   std::size_t depth_count = 0; ///< depth frames in the recording
   std::size_t color_count = 0; ///< colour frames in the recording
@@ -158,7 +162,7 @@ struct OniFileSource::Impl {
       image->fillDepthImageRaw(depth->width, depth->height, depth->mm.data());
     }
     catch (const std::exception& failure) {
-      setError(file + ": cannot read a depth frame: " + failure.what());
+      setError(file + ": cannot read a depth frame: " + errorText(failure));
       return;
     }
     const auto no_sample = image->getNoSampleValue();
@@ -201,7 +205,7 @@ struct OniFileSource::Impl {
     catch (const std::exception& failure) {
       setError(file + ": cannot read a colour frame of " +
                std::to_string(frame->getWidth()) + "x" +
-               std::to_string(frame->getHeight()) + " px: " + failure.what());
+               std::to_string(frame->getHeight()) + " px: " + errorText(failure));
       return;
     }
 
@@ -272,14 +276,15 @@ struct OniFileSource::Impl {
 };
 
 OniFileSource::OniFileSource(const std::string& file)
-    : impl_(std::make_unique<Impl>())
+    : file_(file)
+    , impl_(std::make_unique<Impl>())
 {
   impl_->file = file;
   checkOniHeader(file);
 
   Impl& impl = *impl_;
   try {
-    impl.grabber = std::make_unique<pcl::io::OpenNI2Grabber>(file);
+    impl.grabber = pcl::make_shared<pcl::io::OpenNI2Grabber>(file);
     auto device = impl.grabber->getDevice();
     if (!device || !device->isFile())
       fail(file + ": OpenNI2 did not open the file as a recording");
@@ -346,7 +351,7 @@ OniFileSource::OniFileSource(const std::string& file)
   }
   catch (const std::exception& error) {
     impl.stop();
-    fail(file + ": cannot play the recording: " + error.what());
+    fail(file + ": cannot play the recording: " + errorText(error));
   }
   PCL_DEBUG("[dynvo::OniFileSource] %s: %zu depth and %zu colour frames\n",
             file.c_str(), impl.depth_count, impl.color_count);

@@ -1,4 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <dynvo/common/timestamps.h>
+#include <dynvo/io/partial_file.h>
 #include <dynvo/io/trajectory_io.h>
 
 #include <pcl/exceptions.h>
@@ -11,9 +13,20 @@
 
 namespace dynvo {
 
+namespace {
+
+/// Largest accepted magnitude of a stamp (s) or coordinate (m): far beyond any recording,
+/// small enough that squared errors summed over millions of poses stay finite.
+constexpr double MAX_MAGNITUDE = 1e15;
+
+} // namespace
+
 Trajectory
 readTrajectory(const std::string& path)
 {
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error))
+    throw pcl::IOException(path + ": is a folder, not a trajectory file");
   std::ifstream in(path);
   if (!in)
     throw pcl::IOException(path + ": cannot open trajectory file");
@@ -32,18 +45,13 @@ readTrajectory(const std::string& path)
     std::vector<double> values;
     std::string token;
     while (tokens >> token) {
-      std::size_t used = 0;
-      double value = NAN;
-      try {
-        value = std::stod(token, &used);
-      }
-      catch (const std::exception&) {
-        used = 0;
-      }
-      if (used != token.size())
-        throw pcl::IOException(where + "'" + token + "' is not a number");
-      if (!std::isfinite(value))
-        throw pcl::IOException(where + "value '" + token + "' is not finite");
+      double value = 0.0;
+      if (!parseDecimal(token, value))
+        throw pcl::IOException(where + "'" + token +
+                               "' is not a finite decimal number");
+      if (std::abs(value) > MAX_MAGNITUDE)
+        throw pcl::IOException(where + "value '" + token +
+                               "' is out of range (magnitude above 1e15)");
       values.push_back(value);
     }
     if (values.size() != 8)
@@ -86,22 +94,10 @@ formatTumLine(const StampedPose& pose)
 void
 writeTrajectory(const std::string& path, const Trajectory& trajectory)
 {
-  const std::string partial = path + ".partial";
-  {
-    std::ofstream out(partial, std::ios::trunc);
-    if (!out)
-      throw pcl::IOException(path + ": cannot write trajectory file");
-    out << "# timestamp tx ty tz qx qy qz qw (camera-to-world, metres)\n";
-    for (const StampedPose& pose : trajectory)
-      out << formatTumLine(pose) << '\n';
-    if (!out.flush())
-      throw pcl::IOException(path + ": write failed");
-  }
-  std::error_code error;
-  std::filesystem::rename(partial, path, error);
-  if (error)
-    throw pcl::IOException(path + ": cannot move the written file into place (" +
-                           error.message() + ")");
+  std::string text = "# timestamp tx ty tz qx qy qz qw (camera-to-world, metres)\n";
+  for (const StampedPose& pose : trajectory)
+    text += formatTumLine(pose) + '\n';
+  replaceFile(path, text);
 }
 
 } // namespace dynvo

@@ -2,11 +2,14 @@
 #include <dynvo/common/timestamps.h>
 #include <dynvo/io/tum_folder_source.h>
 
+#include "image_file.h"
+
+#include <pcl/console/print.h>
 #include <pcl/exceptions.h>
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -51,17 +54,10 @@ struct StampedFile {
 double
 parseStamp(const std::string& token, const fs::path& path, int line)
 {
-  std::size_t used = 0;
-  double stamp = std::numeric_limits<double>::quiet_NaN();
-  try {
-    stamp = std::stod(token, &used);
-  }
-  catch (const std::exception&) {
-    used = 0;
-  }
-  if (used != token.size() || !std::isfinite(stamp))
+  double stamp = 0.0;
+  if (!parseDecimal(token, stamp))
     fail(path.string() + ":" + std::to_string(line) + ": bad timestamp '" + token +
-         "'");
+         "' (expected a finite decimal number of seconds)");
   return stamp;
 }
 
@@ -83,11 +79,9 @@ readFileList(const fs::path& path)
 }
 
 ColorImage
-readColor(const fs::path& path)
+readColor(const fs::path& path, std::uint64_t max_pixels)
 {
-  cv::Mat image = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
-  if (image.empty())
-    fail(path.string() + ": cannot read colour image (missing or corrupt)");
+  const cv::Mat image = readImageFile(path.string(), "colour image", max_pixels);
   if (image.depth() != CV_8U || (image.channels() != 3 && image.channels() != 4))
     fail(path.string() + ": colour image must be 8-bit with 3 or 4 channels, got " +
          std::to_string(8 * image.elemSize1()) + "-bit with " +
@@ -112,11 +106,9 @@ readColor(const fs::path& path)
 }
 
 DepthImage
-readDepth(const fs::path& path, double depth_scale)
+readDepth(const fs::path& path, double depth_scale, std::uint64_t max_pixels)
 {
-  cv::Mat image = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
-  if (image.empty())
-    fail(path.string() + ": cannot read depth image (missing or corrupt)");
+  const cv::Mat image = readImageFile(path.string(), "depth image", max_pixels);
   if (image.type() != CV_16UC1)
     fail(path.string() + ": depth image must be 16-bit single channel, got " +
          std::to_string(8 * image.elemSize1()) + "-bit with " +
@@ -175,6 +167,13 @@ TumFolderSource::TumFolderSource(const std::string& folder, const Options& optio
     for (const auto& [i, j] :
          associateTimestamps(rgb_stamps, depth_stamps, options_.max_difference))
       entries_.push_back({rgb[i].stamp, rgb[i].file, depth[j].stamp, depth[j].file});
+    if (entries_.size() < rgb.size())
+      PCL_WARN(
+          "[dynvo::TumFolderSource] %s: %zu of %zu colour images have no depth "
+          "image within %g s (duplicate, out-of-order or distant stamps in rgb.txt "
+          "or depth.txt); those frames are skipped\n",
+          folder.c_str(), rgb.size() - entries_.size(), rgb.size(),
+          options_.max_difference);
   }
   if (entries_.empty())
     fail(folder + ": no colour image has a depth image within " +
@@ -185,6 +184,24 @@ TumFolderSource::TumFolderSource(const std::string& folder, const Options& optio
            " (" + entries_[i].rgb_file + ")");
 }
 
+std::vector<std::string>
+TumFolderSource::inputPaths() const
+{
+  const fs::path dir(folder_);
+  std::vector<std::string> paths;
+  for (const char* index :
+       {"rgb.txt", "depth.txt", "associations.txt", "groundtruth.txt"})
+    if (fs::exists(dir / index))
+      paths.push_back((dir / index).string());
+  for (const Entry& entry : entries_)
+    for (const std::string& file : {entry.rgb_file, entry.depth_file}) {
+      const std::string folder = (dir / file).parent_path().string();
+      if (std::find(paths.begin(), paths.end(), folder) == paths.end())
+        paths.push_back(folder);
+    }
+  return paths;
+}
+
 Frame
 TumFolderSource::read(std::size_t i) const
 {
@@ -193,8 +210,9 @@ TumFolderSource::read(std::size_t i) const
   Frame frame;
   frame.timestamp = entry.rgb_stamp;
   frame.name = (dir / entry.rgb_file).string();
-  frame.color = readColor(dir / entry.rgb_file);
-  frame.depth = readDepth(dir / entry.depth_file, depth_scale_);
+  frame.color = readColor(dir / entry.rgb_file, options_.max_frame_pixels);
+  frame.depth =
+      readDepth(dir / entry.depth_file, depth_scale_, options_.max_frame_pixels);
   if (frame.color.width != frame.depth.width ||
       frame.color.height != frame.depth.height)
     fail((dir / entry.depth_file).string() + ": depth image size differs from " +

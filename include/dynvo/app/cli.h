@@ -57,6 +57,10 @@ public:
   /// The flag's value as an integer. \throws UsageError when it does not parse
   long integer(const std::string& name, long fallback) const;
 
+  /// The flag's value as an integer within [low, high] (the fallback is not checked).
+  /// \throws UsageError when it does not parse or is out of range
+  long integer(const std::string& name, long fallback, long low, long high) const;
+
   /// Positional arguments in order.
   const std::vector<std::string>& positional() const { return positional_; }
 
@@ -70,8 +74,14 @@ private:
   bool help_ = false;
 };
 
-/// The message of an exception without PCLException's ": " prefix.
+/// errorText(e) (no PCLException location, "out of memory" for std::bad_alloc) with long
+/// words shortened (see shortenLongWords()).
 DYNVO_EXPORTS std::string errorMessage(const std::exception& e);
+
+/// The text with every word (run of non-blanks) over 200 characters cut to its first 120
+/// and last 40 characters around "...(N characters)...", so that a huge file name does
+/// not flood the terminal.
+DYNVO_EXPORTS std::string shortenLongWords(const std::string& text);
 
 /** \brief Runs an app's body with the house exit-code policy.
  * UsageError: message and usage on stderr, exit 2. Other std::exception: message via

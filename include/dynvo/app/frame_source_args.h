@@ -6,11 +6,15 @@
 #include <dynvo/common/camera.h>
 #include <dynvo/io/frame_source.h>
 
+#include <cstddef>
+#include <functional>
+#include <string>
 #include <vector>
 
 namespace dynvo::app {
 
-/// -tum_dir, -pcd_dir, -oni, -camera, -fx, -fy, -cx, -cy, -depth_scale, -fps.
+/// -tum_dir, -pcd_dir, -oni, -camera, -fx, -fy, -cx, -cy, -depth_scale, -fps,
+/// -max_frame_pixels.
 DYNVO_EXPORTS std::vector<Option> frameSourceOptions();
 
 /// Intrinsics from -camera (preset, default "default") overridden by -fx -fy -cx -cy.
@@ -21,5 +25,23 @@ DYNVO_EXPORTS CameraIntrinsics intrinsicsFromArguments(const Arguments& args);
  * \throws pcl::IOException when the source cannot be opened
  */
 DYNVO_EXPORTS FrameSource::Ptr openFrameSource(const Arguments& args);
+
+/// How a pass over a recording ended.
+struct FrameLoopEnd {
+  std::size_t frames = 0; ///< frames processed completely
+  std::string error;      ///< why it stopped early; "" at the end or after max_frames
+};
+
+/** \brief Hands each frame of the source to process() until the recording ends,
+ * max_frames are done, or anything throws (a file that cannot be read, a frame the
+ * pipeline refuses, std::bad_alloc). The exception is caught and reported with
+ * pcl::console::print_error as "Error: <frame file>: <why> (stopped after N frames ...)",
+ * so that the app still writes what was computed and then exits 1.
+ * \param[in] max_frames frames to process at most (0 = all)
+ */
+DYNVO_EXPORTS FrameLoopEnd
+processFrames(FrameSource& source,
+              std::size_t max_frames,
+              const std::function<void(const Frame&)>& process);
 
 } // namespace dynvo::app

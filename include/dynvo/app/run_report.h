@@ -3,18 +3,22 @@
 #pragma once
 
 #include <dynvo/app/odometry_pipeline.h>
+#include <dynvo/io/partial_file.h>
 #include <dynvo/io/trajectory_io.h>
 
 #include <cstddef>
 #include <fstream>
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace dynvo::app {
 
-/** \brief The files of a run. Label images are written as frames arrive; the trajectory and
- * the objects file are written beside their destination and moved into place by finish(), so
- * an interrupted run leaves earlier files untouched and what was computed is never lost.
+/** \brief The files of a run. Label images are written as frames arrive (each replaced
+ * whole); the trajectory and the objects file are written beside their destination
+ * ("<file>.partial") and moved into place by finish(), so an interrupted run leaves
+ * earlier files untouched. finish() writes nothing when no frame was added, so a run that
+ * fails on its first frame replaces nothing.
  */
 class DYNVO_EXPORTS RunOutputs {
 public:
@@ -32,7 +36,8 @@ public:
   /// Records one frame. \throws pcl::IOException when a file cannot be written
   void add(const FrameResult& result);
 
-  /// Writes the trajectory and moves the objects file into place.
+  /// Writes the trajectory and moves the objects file into place, when a frame was added.
+  /// \throws pcl::IOException when a file cannot be written
   void finish();
 
   /// Camera poses so far (camera-to-world).
@@ -44,6 +49,7 @@ private:
   std::string objects_path_;
   const Trajectory* initial_groundtruth_;
   Eigen::Isometry3d T_world_start_ = Eigen::Isometry3d::Identity();
+  std::unique_ptr<PartialFile> objects_file_; ///< removes the partial file unless moved
   std::ofstream objects_;
   Trajectory trajectory_;
 };

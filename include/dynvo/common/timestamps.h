@@ -5,10 +5,20 @@
 #include <dynvo/common/export.h>
 
 #include <cstddef>
+#include <string>
 #include <utility>
 #include <vector>
 
 namespace dynvo {
+
+/** \brief Parses a plain decimal number, the only form text files may hold:
+ * `[+-]digits[.digits][(e|E)[+-]digits]` (or `.digits`), with a finite value. Hexadecimal
+ * (`0x1p3`), `inf`, `nan` and trailing characters are refused (std::stod takes them).
+ * \param[in] token the whole text
+ * \param[out] value the number; untouched when false is returned
+ * \return true when the token is such a number
+ */
+DYNVO_EXPORTS bool parseDecimal(const std::string& token, double& value);
 
 /** \brief One-to-one association of two timestamp lists, as associate.py does.
  *

@@ -38,6 +38,24 @@ struct Frame {
   DepthImage depth; ///< the depth image the cloud was made from (metres)
 };
 
+/// Default frame-size limit of the readers (pixels, 4096 x 4096): a frame costs about
+/// 40 bytes per pixel through the pipeline (0.7 GB here), and a small file whose header
+/// claims more is refused before anything is allocated. Apps raise it with
+/// -max_frame_pixels.
+constexpr std::uint64_t DEFAULT_MAX_FRAME_PIXELS = 4096ULL * 4096ULL;
+
+/** \brief Refuses a frame larger than the limit before it is allocated.
+ * \param[in] name the file, for the message
+ * \param[in] width columns (px)
+ * \param[in] height rows (px)
+ * \param[in] max_pixels the limit (DEFAULT_MAX_FRAME_PIXELS unless raised)
+ * \throws pcl::IOException "<name>: frame of WxH px is over the frame-size limit ..."
+ */
+DYNVO_EXPORTS void checkFrameSize(const std::string& name,
+                                  std::uint32_t width,
+                                  std::uint32_t height,
+                                  std::uint64_t max_pixels);
+
 /** \brief Organized cloud from a colour and a depth image of equal size.
  * A pixel whose depth is NaN, zero or negative becomes a NaN point (its colour is kept).
  * \throws std::invalid_argument when the sizes differ

@@ -6,6 +6,8 @@
 
 #include <cstddef>
 #include <memory>
+#include <string>
+#include <vector>
 
 namespace dynvo {
 
@@ -35,6 +37,10 @@ public:
 
   /// Number of frames in the whole sequence, or 0 when the source cannot tell.
   virtual std::size_t size() const = 0;
+
+  /// The files and folders the source reads (index files, image folders, the recording),
+  /// so that an app can refuse to write over them. Empty when the source cannot tell.
+  virtual std::vector<std::string> inputPaths() const { return {}; }
 };
 
 } // namespace dynvo

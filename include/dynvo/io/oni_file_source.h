@@ -48,7 +48,11 @@ public:
 
   std::size_t size() const override;
 
+  /// The recording.
+  std::vector<std::string> inputPaths() const override { return {file_}; }
+
 private:
+  std::string file_;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -5,6 +5,7 @@
 #include <dynvo/common/export.h>
 #include <dynvo/io/frame_source.h>
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,8 @@ public:
     double depth_scale =
         0.0; ///< raw units per metre; 0 = 5000 (TUM) or 1000 (associations.txt)
     double max_difference = 0.02; ///< association tolerance (seconds)
+    std::uint64_t max_frame_pixels =
+        DEFAULT_MAX_FRAME_PIXELS; ///< larger images are refused before decoding
   };
 
   /// One associated colour/depth pair.
@@ -41,6 +44,9 @@ public:
   bool next(Frame& frame) override;
 
   std::size_t size() const override { return entries_.size(); }
+
+  /// The index files, groundtruth.txt (when present) and the folders of the listed images.
+  std::vector<std::string> inputPaths() const override;
 
   /// The associated pairs, in time order.
   const std::vector<Entry>& entries() const { return entries_; }
