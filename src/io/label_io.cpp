@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <dynvo/io/label_io.h>
 
+#include "png_file.h"
+
 #include <pcl/exceptions.h>
 
 #include <opencv2/core.hpp>
@@ -61,9 +63,7 @@ writeLabelImage(const std::string& path, const LabelImage& labels)
 LabelImage
 readLabelImage(const std::string& path)
 {
-  const cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
-  if (image.empty())
-    throw pcl::IOException(path + ": cannot read label image (missing or corrupt)");
+  const cv::Mat image = detail::readPngUnchanged(path, "label image");
   if (image.type() != CV_8UC1)
     throw pcl::IOException(path + ": label image must be 8-bit single channel");
   LabelImage labels;
