@@ -5,6 +5,7 @@
 #include <dynvo/io/trajectory_io.h>
 #include <dynvo/io/tum_folder_source.h>
 #include <dynvo/synth/depth_sensor_model.h>
+#include <dynvo/synth/scene_compositor.h>
 #include <dynvo/synth/scene_synthesizer.h>
 
 #include "support/temp_dir.h"
@@ -785,4 +786,35 @@ TEST(SceneSynthesizer, CompositeRefusesBadRecordingsAndObjectlessScenarios)
   EXPECT_THROW(dynvo::app::writeCompositeSequence(options, composite, dir.file("b")),
                pcl::IOException);
   EXPECT_FALSE(fs::exists(dir.path() / "b")); // inputs are checked before any output
+}
+
+TEST(SceneCompositor, ContractOnPlainInputs)
+{
+  dynvo::SynthOptions options;
+  options.scenario = "moving_static"; // no objects
+  EXPECT_THROW(dynvo::SceneCompositor{options}, std::invalid_argument);
+  options.scenario = "moving_crossing";
+  dynvo::SceneCompositor compositor(options);
+  const dynvo::ColorImage color{16, 12, std::vector<std::uint8_t>(576, 100)};
+  const dynvo::RawDepthImage depth{16, 12, std::vector<std::uint16_t>(192, 10000)};
+  EXPECT_THROW(compositor.composite(0, color, depth),
+               std::invalid_argument);                            // no recording
+  const dynvo::CameraIntrinsics camera{13.125, 13.125, 7.5, 5.5}; // 525 px at 640
+  const std::vector<Eigen::Isometry3d> poses(2, Eigen::Isometry3d::Identity());
+  EXPECT_THROW(compositor.setRecording(camera, 5000.0, {1.0}, poses, color, depth),
+               std::invalid_argument); // one pose per stamp
+  EXPECT_THROW(compositor.setRecording(camera, 5000.0, {1.0, 1.1}, poses, color,
+                                       {16, 12, std::vector<std::uint16_t>(192, 0)}),
+               std::invalid_argument); // no measurement in the first depth image
+  compositor.setRecording(camera, 5000.0, {1.0, 1.1}, poses, color, depth);
+  EXPECT_GT(compositor.objectScale(), 0.0);
+  EXPECT_LE(compositor.objectScale(), 1.0);
+  const dynvo::CompositeFrame frame = compositor.composite(1, color, depth);
+  EXPECT_EQ(frame.depth.data.size(), 192u);
+  EXPECT_EQ(frame.labels.data.size(), 192u);
+  EXPECT_FALSE(frame.objects.empty());
+  EXPECT_THROW(compositor.composite(2, color, depth), std::invalid_argument);
+  EXPECT_THROW(compositor.composite(0, {2, 2, std::vector<std::uint8_t>(12, 0)},
+                                    {2, 2, std::vector<std::uint16_t>(4, 1)}),
+               std::invalid_argument);
 }
