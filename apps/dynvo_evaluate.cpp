@@ -2,8 +2,10 @@
 // dynvo_evaluate GT EST: RPE and ATE of an estimated TUM trajectory against ground truth.
 // dynvo_evaluate -labels PRED_DIR -truth SEQ_DIR: segmentation scores of label PNGs.
 #include <dynvo/app/cli.h>
+#include <dynvo/app/segmentation_evaluation.h>
 #include <dynvo/eval/label_metrics.h>
 #include <dynvo/eval/trajectory_metrics.h>
+#include <dynvo/io/trajectory_io.h>
 
 #include <pcl/console/print.h>
 
@@ -45,7 +47,7 @@ evaluateLabels(const dynvo::app::Arguments& args)
       throw dynvo::app::UsageError(std::string("-") + trajectory_only +
                                    " applies to trajectories, not to -labels");
   const dynvo::SegmentationEvaluation result =
-      dynvo::evaluateSegmentation(args.string("labels"), args.string("truth"));
+      dynvo::app::evaluateSegmentation(args.string("labels"), args.string("truth"));
   if (result.scores.frames < result.sequence_frames)
     pcl::console::print_warn(
         "Warning: %zu of %zu frames of %s have no label PNG within %.3f s in %s; "

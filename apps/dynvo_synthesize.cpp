@@ -3,6 +3,7 @@
 #include <dynvo/app/cli.h>
 #include <dynvo/app/frame_source_args.h>
 #include <dynvo/app/output_guard.h>
+#include <dynvo/app/synthesize.h>
 #include <dynvo/synth/scene_synthesizer.h>
 
 #include <pcl/console/print.h>
@@ -44,7 +45,7 @@ composite(const dynvo::app::Arguments& args)
   options.scenario = args.string("scenario", options.scenario);
   options.seed =
       static_cast<std::uint32_t>(args.integer("seed", options.seed, 0, 4294967295L));
-  dynvo::CompositeOptions composite;
+  dynvo::app::CompositeOptions composite;
   composite.recording = args.string("composite");
   composite.intrinsics = dynvo::app::intrinsicsFromArguments(args);
   composite.depth_scale = args.number("depth_scale", 0.0);
@@ -59,7 +60,7 @@ composite(const dynvo::app::Arguments& args)
   pcl::console::TicToc timer;
   timer.tic();
   try {
-    dynvo::SceneSynthesizer(options).writeComposite(composite, out);
+    dynvo::app::writeCompositeSequence(options, composite, out);
   }
   catch (const std::invalid_argument& e) { // a scenario without objects
     throw dynvo::app::UsageError(e.what());
@@ -151,7 +152,7 @@ main(int argc, char** argv)
     const std::string out = args.string("out");
     pcl::console::TicToc timer;
     timer.tic();
-    dynvo::SceneSynthesizer(options).writeSequence(out, threads);
+    dynvo::app::writeSyntheticSequence(options, out, threads);
     pcl::console::print_highlight(
         "Wrote %d frames of '%s' (%dx%d, seed %u, %s depth) to %s in ", options.frames,
         options.scenario.c_str(), options.width, options.height, options.seed,

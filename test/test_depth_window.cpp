@@ -52,7 +52,7 @@ TEST(DepthWindow, AveragesTheSensorNoiseAway)
 {
   // Walls at 1-2.2 m with sigma = 1.2e-3 z^2 per pixel plus disparity quantisation: one pixel
   // per end leaves several millimetres. The window fits about 40 agreeing samples, so the
-  // noise should drop by well over half (measured 4.9 -> 0.85 mm).
+  // noise should drop by well over half (measured: pcl_modules/scene_flow/NOTES.md).
   const double single = medianFlowError(true, 0);
   const double window = medianFlowError(true, 6);
   EXPECT_GT(single, 0.002);
@@ -62,8 +62,8 @@ TEST(DepthWindow, AveragesTheSensorNoiseAway)
 TEST(DepthWindow, IsExactOnNoiseFreePlanes)
 {
   // The room is made of planes, on which inverse depth is linear in the pixel coordinates:
-  // the fit reproduces the exact depth, so only the LK error (a few hundredths of a pixel,
-  // 0.07 mm measured) remains, as with the single pixel.
+  // the fit reproduces the exact depth, so only the LK error (a few hundredths of a pixel)
+  // remains, as with the single pixel.
   const double single = medianFlowError(false, 0);
   const double window = medianFlowError(false, 6);
   EXPECT_LT(window, 0.0003);

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "support/shared_data.h"
 #include "support/run_command.h"
 #include "support/temp_dir.h"
 
@@ -199,9 +200,8 @@ TEST_F(EvaluateLabels, WithoutTruthLabelsReportsTheMovingShareOfAStaticRecording
 TEST(EvaluateLabelsRealData, AllStaticPredictionOnTumFr1XyzHasNoMovingShare)
 {
   const auto sequence =
-      std::filesystem::path(DYNVO_SHARED_DATA_DIR) / "tum_fr1_xyz_200";
-  if (!std::filesystem::exists(sequence / "rgb.txt"))
-    GTEST_SKIP() << "shared data not found at " << sequence;
+      std::filesystem::path(dynvo::test::sharedDataPath("tum_fr1_xyz_200"));
+  DYNVO_REQUIRE_SHARED_DATA((sequence / "rgb.txt").string());
   // The first 5 frames predicted static everywhere, named as dynvo_odometry names them.
   TempDir dir;
   const dynvo::TumFolderSource source(sequence.string(), {});

@@ -2,6 +2,7 @@
 // Bad input through the apps: every case checks the exit code, that the message names the
 // file, and that a file already at an output path is untouched (issue 17). The fixtures
 // are made here: a small synthetic sequence, then one thing broken per case.
+#include <dynvo/app/synthesize.h>
 #include <dynvo/io/trajectory_io.h>
 #include <dynvo/synth/scene_synthesizer.h>
 
@@ -45,7 +46,7 @@ protected:
     options.frames = FRAMES;
     options.width = 160;
     options.height = 120;
-    dynvo::SceneSynthesizer(options).writeSequence(sequence_->file("seq"), 2);
+    dynvo::app::writeSyntheticSequence(options, sequence_->file("seq"), 2);
   }
 
   static void TearDownTestSuite() { delete sequence_; }

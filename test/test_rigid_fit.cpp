@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "support/rigid_motion.h"
+#include "support/pose_compare.h"
 
 #include <Eigen/Geometry>
 

@@ -1,9 +1,11 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // SceneSynthesizer: determinism, geometry, labels, depth model, scenarios, files.
+#include <dynvo/app/synthesize.h>
 #include <dynvo/io/label_io.h>
 #include <dynvo/io/trajectory_io.h>
 #include <dynvo/io/tum_folder_source.h>
 #include <dynvo/synth/depth_sensor_model.h>
+#include <dynvo/synth/scene_compositor.h>
 #include <dynvo/synth/scene_synthesizer.h>
 
 #include "support/temp_dir.h"
@@ -106,9 +108,8 @@ TEST(SceneSynthesizer, WrittenBytesDoNotDependOnThreads)
   dynvo::SynthOptions options = smallOptions("moving_crossing");
   options.frames = 4;
   const dynvo::test::TempDir dir;
-  const dynvo::SceneSynthesizer synth(options);
-  synth.writeSequence(dir.file("one"), 1);
-  synth.writeSequence(dir.file("two"), 2);
+  dynvo::app::writeSyntheticSequence(options, dir.file("one"), 1);
+  dynvo::app::writeSyntheticSequence(options, dir.file("two"), 2);
   const auto one = readTree(dir.path() / "one");
   // 3 PNGs per frame and 4 index files.
   EXPECT_EQ(one.size(), 3U * options.frames + 4U);
@@ -587,7 +588,8 @@ TEST(SceneSynthesizer, RejectsBadOptions)
   EXPECT_THROW(synth.render(-1), std::invalid_argument);
   EXPECT_THROW(synth.render(3), std::invalid_argument);
   const dynvo::test::TempDir dir;
-  EXPECT_THROW(synth.writeSequence(dir.file("out"), 0), std::invalid_argument);
+  EXPECT_THROW(dynvo::app::writeSyntheticSequence(options, dir.file("out"), 0),
+               std::invalid_argument);
   EXPECT_FALSE(fs::exists(dir.file("out")));
 }
 
@@ -599,7 +601,7 @@ TEST(SceneSynthesizer, RefusesNonEmptyFolderAndTouchesNothing)
   dynvo::test::writeText(dir.file("rgb.txt"), "keep me\n");
   const auto before = readTree(dir.path());
   try {
-    dynvo::SceneSynthesizer(options).writeSequence(dir.path().string(), 2);
+    dynvo::app::writeSyntheticSequence(options, dir.path().string(), 2);
     FAIL() << "expected pcl::IOException";
   }
   catch (const pcl::IOException& e) {
@@ -615,7 +617,7 @@ TEST(SceneSynthesizer, WrittenSequenceReadsBackAsTum)
   options.frames = 3;
   const dynvo::test::TempDir dir;
   const dynvo::SceneSynthesizer synth(options);
-  synth.writeSequence(dir.file("seq"), 2);
+  dynvo::app::writeSyntheticSequence(options, dir.file("seq"), 2);
 
   dynvo::TumFolderSource::Options read_options;
   read_options.intrinsics = synth.intrinsics();
@@ -716,13 +718,13 @@ TEST(SceneSynthesizer, CompositeKeepsRealPixelsAndLabelsTheVisibleObject)
   writeRecording(dir.path() / "real", frames, w, h);
   dynvo::SynthOptions options;
   options.scenario = "moving_crossing";
-  dynvo::CompositeOptions composite;
+  dynvo::app::CompositeOptions composite;
   composite.recording = (dir.path() / "real").string();
   composite.intrinsics = dynvo::CameraIntrinsics::fromPreset("default");
   composite.intrinsics.fx = composite.intrinsics.fy = 131.25; // 525 at quarter size
   composite.intrinsics.cx = 79.5;
   composite.intrinsics.cy = 59.5;
-  dynvo::SceneSynthesizer(options).writeComposite(composite, dir.file("out"));
+  dynvo::app::writeCompositeSequence(options, composite, dir.file("out"));
 
   const fs::path out = dir.path() / "out";
   const auto groundtruth = dynvo::readTrajectory((out / "groundtruth.txt").string());
@@ -773,17 +775,46 @@ TEST(SceneSynthesizer, CompositeRefusesBadRecordingsAndObjectlessScenarios)
 {
   const dynvo::test::TempDir dir;
   writeRecording(dir.path() / "real", 3, 32, 24);
-  dynvo::CompositeOptions composite;
+  dynvo::app::CompositeOptions composite;
   composite.recording = (dir.path() / "real").string();
   dynvo::SynthOptions options;
   options.scenario = "moving_static";
-  EXPECT_THROW(
-      dynvo::SceneSynthesizer(options).writeComposite(composite, dir.file("a")),
-      std::invalid_argument);
+  EXPECT_THROW(dynvo::app::writeCompositeSequence(options, composite, dir.file("a")),
+               std::invalid_argument);
   options.scenario = "moving_crossing";
   fs::remove(dir.path() / "real/groundtruth.txt");
-  EXPECT_THROW(
-      dynvo::SceneSynthesizer(options).writeComposite(composite, dir.file("b")),
-      pcl::IOException);
+  EXPECT_THROW(dynvo::app::writeCompositeSequence(options, composite, dir.file("b")),
+               pcl::IOException);
   EXPECT_FALSE(fs::exists(dir.path() / "b")); // inputs are checked before any output
+}
+
+TEST(SceneCompositor, ContractOnPlainInputs)
+{
+  dynvo::SynthOptions options;
+  options.scenario = "moving_static"; // no objects
+  EXPECT_THROW(dynvo::SceneCompositor{options}, std::invalid_argument);
+  options.scenario = "moving_crossing";
+  dynvo::SceneCompositor compositor(options);
+  const dynvo::ColorImage color{16, 12, std::vector<std::uint8_t>(576, 100)};
+  const dynvo::RawDepthImage depth{16, 12, std::vector<std::uint16_t>(192, 10000)};
+  EXPECT_THROW(compositor.composite(0, color, depth),
+               std::invalid_argument);                            // no recording
+  const dynvo::CameraIntrinsics camera{13.125, 13.125, 7.5, 5.5}; // 525 px at 640
+  const std::vector<Eigen::Isometry3d> poses(2, Eigen::Isometry3d::Identity());
+  EXPECT_THROW(compositor.setRecording(camera, 5000.0, {1.0}, poses, color, depth),
+               std::invalid_argument); // one pose per stamp
+  EXPECT_THROW(compositor.setRecording(camera, 5000.0, {1.0, 1.1}, poses, color,
+                                       {16, 12, std::vector<std::uint16_t>(192, 0)}),
+               std::invalid_argument); // no measurement in the first depth image
+  compositor.setRecording(camera, 5000.0, {1.0, 1.1}, poses, color, depth);
+  EXPECT_GT(compositor.objectScale(), 0.0);
+  EXPECT_LE(compositor.objectScale(), 1.0);
+  const dynvo::CompositeFrame frame = compositor.composite(1, color, depth);
+  EXPECT_EQ(frame.depth.data.size(), 192u);
+  EXPECT_EQ(frame.labels.data.size(), 192u);
+  EXPECT_FALSE(frame.objects.empty());
+  EXPECT_THROW(compositor.composite(2, color, depth), std::invalid_argument);
+  EXPECT_THROW(compositor.composite(0, {2, 2, std::vector<std::uint8_t>(12, 0)},
+                                    {2, 2, std::vector<std::uint16_t>(4, 1)}),
+               std::invalid_argument);
 }

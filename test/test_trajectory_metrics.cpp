@@ -1,5 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <dynvo/eval/trajectory_metrics.h>
+#include <dynvo/io/trajectory_io.h>
+
+#include "support/shared_data.h"
 
 #include <gtest/gtest.h>
 
@@ -127,10 +130,10 @@ TEST(TrajectoryMetrics, DegenerateInputsThrow)
 
 TEST(TrajectoryMetricsRealData, Fr1GroundTruthAgainstDriftingCopy)
 {
-  const auto path = std::filesystem::path(DYNVO_SHARED_DATA_DIR) / "tum_fr1_xyz_200" /
-                    "groundtruth.txt";
-  if (!std::filesystem::exists(path))
-    GTEST_SKIP() << "shared data not found at " << path;
+  const auto path =
+      std::filesystem::path(dynvo::test::sharedDataPath("tum_fr1_xyz_200")) /
+      "groundtruth.txt";
+  DYNVO_REQUIRE_SHARED_DATA(path.string());
   const auto gt = dynvo::readTrajectory(path.string());
   // Estimate: every third ground-truth pose (about 33 Hz) with a world-frame drift of
   // 2 cm/s along x. The relative error of a pair is the drift over its time span

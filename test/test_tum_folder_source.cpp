@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "support/shared_data.h"
 #include "support/temp_dir.h"
 
 #include <cmath>
@@ -165,10 +166,8 @@ TEST_F(TumFolderTest, BadInputNamesTheFileAndProblem)
 
 TEST(TumFolderRealData, Fr1XyzHas200AssociatedPairs)
 {
-  const fs::path folder = fs::path(DYNVO_SHARED_DATA_DIR) / "tum_fr1_xyz_200";
-  if (!fs::exists(folder / "rgb.txt"))
-    GTEST_SKIP() << "shared data not found at " << folder
-                 << " (set -DDYNVO_SHARED_DATA_DIR=...)";
+  const fs::path folder = dynvo::test::sharedDataPath("tum_fr1_xyz_200");
+  DYNVO_REQUIRE_SHARED_DATA((folder / "rgb.txt").string());
   dynvo::TumFolderSource::Options options;
   options.intrinsics = dynvo::CameraIntrinsics::fromPreset("fr1");
   dynvo::TumFolderSource source(folder.string(), options);

@@ -14,7 +14,7 @@ struct Preset {
 };
 
 // TUM values: https://cvg.cit.tum.de/data/datasets/rgbd-dataset/file_formats (ROS default
-// for "default"); ICSL-DE values from the dataset page (ALGORITHM.md §8).
+// for "default"); ICSL-DE values from the dataset page (docs/algorithm.md §8).
 const Preset PRESETS[] = {
     {"default", {525.0, 525.0, 319.5, 239.5}},
     {"fr1", {517.3, 516.5, 318.6, 255.3}},

@@ -1,13 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <dynvo/common/timestamps.h>
+#include <dynvo/io/image_io.h>
 #include <dynvo/io/tum_folder_source.h>
-
-#include "image_file.h"
 
 #include <pcl/console/print.h>
 #include <pcl/exceptions.h>
-
-#include <opencv2/core.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -78,53 +75,19 @@ readFileList(const fs::path& path)
   return list;
 }
 
-ColorImage
-readColor(const fs::path& path, std::uint64_t max_pixels)
-{
-  const cv::Mat image = readImageFile(path.string(), "colour image", max_pixels);
-  if (image.depth() != CV_8U || (image.channels() != 3 && image.channels() != 4))
-    fail(path.string() + ": colour image must be 8-bit with 3 or 4 channels, got " +
-         std::to_string(8 * image.elemSize1()) + "-bit with " +
-         std::to_string(image.channels()) + " channel(s)");
-  ColorImage color;
-  color.width = image.cols;
-  color.height = image.rows;
-  color.data.resize(3 * image.total());
-  const int channels = image.channels();
-  for (int v = 0; v < image.rows; ++v) {
-    const std::uint8_t* row = image.ptr<std::uint8_t>(v);
-    std::uint8_t* out =
-        color.data.data() + 3 * static_cast<std::size_t>(v) * image.cols;
-    for (int u = 0; u < image.cols; ++u) {
-      // OpenCV stores BGR(A).
-      out[3 * u] = row[channels * u + 2];
-      out[3 * u + 1] = row[channels * u + 1];
-      out[3 * u + 2] = row[channels * u];
-    }
-  }
-  return color;
-}
-
+/// Metres from raw units: raw * (1 / scale) in single precision; raw 0 becomes NaN.
 DepthImage
-readDepth(const fs::path& path, double depth_scale, std::uint64_t max_pixels)
+toMetres(const RawDepthImage& raw, double depth_scale)
 {
-  const cv::Mat image = readImageFile(path.string(), "depth image", max_pixels);
-  if (image.type() != CV_16UC1)
-    fail(path.string() + ": depth image must be 16-bit single channel, got " +
-         std::to_string(8 * image.elemSize1()) + "-bit with " +
-         std::to_string(image.channels()) + " channel(s)");
   DepthImage depth;
-  depth.width = image.cols;
-  depth.height = image.rows;
-  depth.data.resize(image.total());
+  depth.width = raw.width;
+  depth.height = raw.height;
+  depth.data.resize(raw.data.size());
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const float inv_scale = static_cast<float>(1.0 / depth_scale);
-  for (int v = 0; v < image.rows; ++v) {
-    const std::uint16_t* row = image.ptr<std::uint16_t>(v);
-    float* out = depth.data.data() + static_cast<std::size_t>(v) * image.cols;
-    for (int u = 0; u < image.cols; ++u)
-      out[u] = row[u] == 0 ? nan : static_cast<float>(row[u]) * inv_scale;
-  }
+  for (std::size_t i = 0; i < raw.data.size(); ++i)
+    depth.data[i] =
+        raw.data[i] == 0 ? nan : static_cast<float>(raw.data[i]) * inv_scale;
   return depth;
 }
 
@@ -210,9 +173,11 @@ TumFolderSource::read(std::size_t i) const
   Frame frame;
   frame.timestamp = entry.rgb_stamp;
   frame.name = (dir / entry.rgb_file).string();
-  frame.color = readColor(dir / entry.rgb_file, options_.max_frame_pixels);
-  frame.depth =
-      readDepth(dir / entry.depth_file, depth_scale_, options_.max_frame_pixels);
+  frame.color =
+      readColorImage((dir / entry.rgb_file).string(), options_.max_frame_pixels);
+  frame.depth = toMetres(
+      readRawDepthImage((dir / entry.depth_file).string(), options_.max_frame_pixels),
+      depth_scale_);
   if (frame.color.width != frame.depth.width ||
       frame.color.height != frame.depth.height)
     fail((dir / entry.depth_file).string() + ": depth image size differs from " +

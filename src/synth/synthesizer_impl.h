@@ -6,16 +6,12 @@
 
 #include "scene_script.h"
 
-#include <dynvo/io/trajectory_io.h>
 #include <dynvo/synth/depth_sensor_model.h>
 
 #include <Eigen/Geometry>
 
-#include <opencv2/core/mat.hpp>
-
 #include <array>
 #include <cstdint>
-#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -97,30 +93,5 @@ struct SceneSynthesizer::Impl {
   /// Poses at time t (s); objects are "moving" when their pose differs at t_previous.
   FrameScript scriptAt(double t, double t_previous) const;
 };
-
-namespace detail {
-
-/// Refuses anything but a missing or empty folder, then creates rgb/, depth/, labels/.
-/// \throws pcl::IOException
-void prepareFolder(const std::filesystem::path& root);
-
-/// Writes a PNG (fast zlib level). \throws pcl::IOException
-void writePng(const std::filesystem::path& path, const cv::Mat& image);
-
-/// rgb/<rgb stamp>.png, depth/<depth stamp>.png, labels/<rgb stamp>.png.
-void writeFrameFiles(const std::filesystem::path& root,
-                     double rgb_stamp,
-                     double depth_stamp,
-                     const cv::Mat& bgr,
-                     const cv::Mat& depth,
-                     const std::vector<std::uint8_t>& labels);
-
-/// rgb.txt, depth.txt, objects.txt (from the scripts) and groundtruth.txt.
-void writeIndexFiles(const std::filesystem::path& root,
-                     const std::string& origin,
-                     const std::vector<FrameScript>& scripts,
-                     const Trajectory& groundtruth);
-
-} // namespace detail
 
 } // namespace dynvo

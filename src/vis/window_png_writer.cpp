@@ -13,7 +13,7 @@ WindowPngWriter::WindowPngWriter(vtkRenderWindow* window)
   grab_->SetInput(window);
   grab_->SetInputBufferTypeToRGB();
   // The caller has just rendered; reading the back buffer avoids a second render
-  // (PLATFORM.md: ReadFrontBufferOff is the reliable choice with off-screen windows).
+  // (docs/platform.md: ReadFrontBufferOff is the reliable choice with off-screen windows).
   grab_->ReadFrontBufferOff();
   grab_->ShouldRerenderOff();
   png_->SetInputConnection(grab_->GetOutputPort());

@@ -96,7 +96,7 @@ BENCHMARK(BM_GridSceneFlowPerFrame)
       return *std::min_element(v.begin(), v.end());
     });
 
-/// Depth preprocessing alone (ALGORITHM.md §1.1) on one VGA depth map. Arg: thread count.
+/// Depth preprocessing alone (docs/algorithm.md §1.1) on one VGA depth map. Arg: thread count.
 void
 BM_DepthPreprocessing(benchmark::State& state)
 {

@@ -6,7 +6,7 @@
 //   (default 33333, i.e. 30 Hz)
 //
 // OpenNI 2 can only record live streams, and OpenNI 1 mock nodes made with plain
-// Create() cannot be added to a recording (PLATFORM.md, "ONI recordings"). So:
+// Create() cannot be added to a recording (docs/platform.md, "ONI recordings"). So:
 //   1. a child process records a few frames of OpenNI 2's built-in "Dummy" device to a
 //      scratch file (its driver crashes on teardown, so the child ends with _exit;
 //      it sometimes deadlocks, so it runs under a watchdog and is retried);

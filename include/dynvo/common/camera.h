@@ -11,7 +11,7 @@
 
 namespace dynvo {
 
-/** \brief Pinhole intrinsics (pixels). Lens distortion is ignored (ALGORITHM.md §1.2).
+/** \brief Pinhole intrinsics (pixels). Lens distortion is ignored (docs/algorithm.md §1.2).
  *
  * Back-projection of pixel (u, v) at depth z (metres) is
  * x = [(u - cx) z / fx, (v - cy) z / fy, z], in the OpenCV optical frame.

@@ -6,7 +6,7 @@
 
 /**
  * \file conventions.h
- * Conventions used throughout dynvo (see ALGORITHM.md §0 and STYLE.md §2.2):
+ * Conventions used throughout dynvo (see docs/algorithm.md §0 and docs/style.md §2.2):
  * - Units: metres, radians, seconds, pixels. Timestamps are seconds (double).
  * - Camera axes: OpenCV optical frame (x right, y down, z forward).
  * - A transform named T_a_b maps points given in frame b into frame a.

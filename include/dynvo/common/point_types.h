@@ -9,7 +9,7 @@
 
 namespace dynvo {
 
-/** \brief One grid cell of the scene flow (ALGORITHM.md §1.2).
+/** \brief One grid cell of the scene flow (docs/algorithm.md §1.2).
  *
  * x, y, z is the cell's point in the current camera frame k (the paper's b_i, metres);
  * prev_x, prev_y, prev_z the same physical point in the previous camera frame k-1 (a_i).

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Weighted least-squares rigid fit of point pairs (ALGORITHM.md §2), shared by the modules.
+// Weighted least-squares rigid fit of point pairs (docs/algorithm.md §2), shared by the modules.
 #pragma once
 
 #include <dynvo/common/export.h>
@@ -20,7 +20,7 @@ enum class RigidFitStatus {
 /** \brief Weighted least-squares rigid fit without scale (Kabsch/Umeyama, Eggert et al. 1997).
  *
  * Finds the rigid T_target_source = [R t; 0 1] minimising
- * sum_i w_i || R s_i + t - q_i ||^2 over pairs (s_i, q_i) (ALGORITHM.md §2). The moments are
+ * sum_i w_i || R s_i + t - q_i ||^2 over pairs (s_i, q_i) (docs/algorithm.md §2). The moments are
  * accumulated in double precision relative to the first pair added, so points far from the
  * origin lose no precision; the 3x3 cross-covariance is decomposed with Eigen's JacobiSVD and a
  * reflection guard keeps det(R) = +1, so planar point sets give a proper rotation.
@@ -77,7 +77,7 @@ private:
 };
 
 /** \brief Squared transfer error E_i = || R s + t - q ||^2 (m^2) of one pair under
- * T_target_source (the paper's eq. 1, ALGORITHM.md §2).
+ * T_target_source (the paper's eq. 1, docs/algorithm.md §2).
  */
 inline double
 squaredTransferError(const Eigen::Matrix4d& T_target_source,

@@ -3,8 +3,7 @@
 #pragma once
 
 #include <dynvo/common/export.h>
-#include <dynvo/io/frame.h>
-#include <dynvo/io/label_io.h>
+#include <dynvo/common/image.h>
 
 #include <cstddef>
 #include <cstdint>
@@ -99,40 +98,20 @@ DYNVO_EXPORTS SegmentationScores
 summarizeSegmentation(const std::vector<LabelFrameCounts>& frames,
                       double background_precision = BACKGROUND_OK_PRECISION);
 
-/// Options of evaluateSegmentation().
+/// Options of app::evaluateSegmentation() (the folder reader, include/dynvo/app).
 struct SegmentationEvaluationOptions {
   double max_difference = 0.005; ///< stamp pairing tolerance (seconds)
   double background_precision = BACKGROUND_OK_PRECISION; ///< bg_ok threshold
 };
 
-/// Scores of a predicted label folder against a sequence folder.
+/// Scores of a predicted label folder against a sequence folder
+/// (app::evaluateSegmentation()).
 struct SegmentationEvaluation {
   SegmentationScores scores;       ///< over the paired frames
   bool has_truth_labels = true;    ///< false: no labels/ folder, every pixel is static
   std::size_t sequence_frames = 0; ///< colour frames of the sequence with a depth image
   std::size_t predictions = 0;     ///< predicted label PNGs in the folder
 };
-
-/** \brief Scores the label PNGs of a dynvo_odometry -labels_dir folder against a sequence.
- *
- * The sequence is a TUM folder (rgb.txt, depth.txt, as read by TumFolderSource): its frames
- * are the colour frames associated with a depth image; a pixel is valid where that depth is
- * non-zero. The truth labels of a frame are labels/<colour stamp %.6f>.png; without a
- * labels/ folder every pixel is truly static (a static real recording). The predictions are
- * the .png files of predicted_dir, named <stamp>.png (digits and one '.', as formatStamp()
- * writes; other files are ignored). Each sequence frame is paired with the prediction of
- * nearest stamp within max_difference, one to one (as associateTimestamps()); unpaired
- * sequence frames and unpaired predictions are not scored (scores.frames counts the pairs;
- * compare it with sequence_frames).
- * \throws pcl::IOException naming the file: a missing folder, a .png not named by a stamp,
- *         no prediction within max_difference of any frame, a missing truth label file, an
- *         unreadable or not 8-bit single-channel PNG, a prediction whose size differs from
- *         its truth labels (or, without labels/, its depth image)
- */
-DYNVO_EXPORTS SegmentationEvaluation
-evaluateSegmentation(const std::string& predicted_dir,
-                     const std::string& sequence_dir,
-                     const SegmentationEvaluationOptions& options = {});
 
 /** \brief The result line of dynvo_evaluate -labels, values with 6 decimals ("nan" when
  * undefined), no trailing newline. With truth labels:

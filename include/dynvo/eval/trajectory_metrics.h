@@ -3,7 +3,7 @@
 #pragma once
 
 #include <dynvo/common/export.h>
-#include <dynvo/io/trajectory_io.h>
+#include <dynvo/common/trajectory.h>
 
 #include <cstddef>
 #include <string>

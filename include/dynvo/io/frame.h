@@ -4,6 +4,7 @@
 
 #include <dynvo/common/camera.h>
 #include <dynvo/common/export.h>
+#include <dynvo/common/image.h>
 
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
@@ -13,20 +14,6 @@
 #include <vector>
 
 namespace dynvo {
-
-/// 8-bit colour image, row-major, 3 bytes per pixel in R, G, B order.
-struct ColorImage {
-  std::uint32_t width = 0;        ///< columns (px)
-  std::uint32_t height = 0;       ///< rows (px)
-  std::vector<std::uint8_t> data; ///< width * height * 3 bytes
-};
-
-/// Depth image in metres, row-major; NaN marks a missing measurement.
-struct DepthImage {
-  std::uint32_t width = 0;  ///< columns (px)
-  std::uint32_t height = 0; ///< rows (px)
-  std::vector<float> data;  ///< width * height depths (metres)
-};
 
 /** \brief One RGB-D frame as delivered by a FrameSource. */
 struct Frame {

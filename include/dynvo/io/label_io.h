@@ -3,6 +3,7 @@
 #pragma once
 
 #include <dynvo/common/export.h>
+#include <dynvo/common/image.h>
 
 #include <pcl/PointIndices.h>
 
@@ -13,13 +14,6 @@
 #include <vector>
 
 namespace dynvo {
-
-/// Per-pixel labels of one frame: 0 no measurement, 1 static background, 2.. moving objects.
-struct LabelImage {
-  std::uint32_t width = 0;        ///< columns (px)
-  std::uint32_t height = 0;       ///< rows (px)
-  std::vector<std::uint8_t> data; ///< width * height labels, row-major
-};
 
 /** \brief Label image of a segmentation: the pixels of segments[s] get labels[s], every
  * other pixel 0 (no measurement). Indices are linear pixel indices (row * width + col).

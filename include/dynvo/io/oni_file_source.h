@@ -17,7 +17,7 @@ namespace dynvo {
  * paired with the colour frame nearest in time (the grabber's own image+depth
  * synchronizer would hold back the last pair). OpenNI2 runs the file device in manual
  * mode (playback speed -1, repeat off) and next() steps it, so reading is not paced by
- * the recorded clock: about 10 ms per 640x480 frame on a loaded 2-core machine.
+ * the recorded clock (it runs as fast as decoding allows).
  *
  * Each Frame has:
  * - timestamp: the depth frame's device time in seconds (OpenNI's player starts the

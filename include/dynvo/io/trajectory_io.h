@@ -3,6 +3,7 @@
 #pragma once
 
 #include <dynvo/common/export.h>
+#include <dynvo/common/trajectory.h>
 
 #include <Eigen/Geometry>
 
@@ -10,14 +11,6 @@
 #include <vector>
 
 namespace dynvo {
-
-/// A camera pose at a time: T_world_camera maps camera coordinates to world (metres).
-struct StampedPose {
-  double timestamp = 0.0;                                           ///< seconds
-  Eigen::Isometry3d T_world_camera = Eigen::Isometry3d::Identity(); ///< camera-to-world
-};
-
-using Trajectory = std::vector<StampedPose>;
 
 /** \brief Read a TUM trajectory file.
  *

@@ -4,7 +4,7 @@
 
 #include <dynvo/common/camera.h>
 #include <dynvo/common/export.h>
-#include <dynvo/io/frame.h>
+#include <dynvo/common/image.h>
 
 #include <Eigen/Geometry>
 
@@ -60,14 +60,6 @@ struct DYNVO_EXPORTS SynthOptions {
 
   /// \throws std::invalid_argument on an unknown scenario or an out-of-range value
   void validate() const;
-};
-
-/// Where and how to composite a scenario's objects into a real recording.
-struct DYNVO_EXPORTS CompositeOptions {
-  std::string recording;       ///< TUM folder: rgb.txt, depth.txt, groundtruth.txt
-  CameraIntrinsics intrinsics; ///< the recording's camera
-  double depth_scale = 0.0;    ///< raw depth units per metre; 0 = the folder's default
-  int frames = 0;              ///< the first N associated frames; 0 = all
 };
 
 /** \brief Renders scripted dynamic scenes by ray casting (deterministic for a seed).
@@ -139,46 +131,8 @@ public:
   /// \throws std::invalid_argument when k is out of range
   SynthFrame render(int k) const;
 
-  /** \brief Write the whole sequence in the TUM layout: rgb/, depth/ (16-bit, 5000 per
-   * metre), labels/ (uint8), rgb.txt, depth.txt, groundtruth.txt, objects.txt.
-   *
-   * Files are named by their stamp ("%.6f.png"); labels use the colour stamp.
-   * groundtruth.txt holds T_world_camera at the colour stamps; objects.txt one line per
-   * frame and object: "timestamp id tx ty tz qx qy qz qw moving" (object-to-world).
-   * \param[in] folder must not exist or be empty; nothing existing is overwritten
-   * \param[in] threads worker threads (>= 1); the bytes written do not depend on it
-   * \throws pcl::IOException when the folder is not empty or cannot be written
-   * \throws std::invalid_argument when threads < 1
-   */
-  void writeSequence(const std::string& folder, int threads) const;
-
-  /** \brief Composites the scenario's rigid objects into a real TUM recording.
-   *
-   * Frame k of the output is associated pair k of the recording, at its stamps; the
-   * camera pose is the recording's ground truth interpolated at the colour stamp
-   * (linear translation, slerp rotation). The scenario's objects are placed as the
-   * scenario places them relative to its camera at frame 0, scaled about that camera
-   * by s = min(1, 0.9 z_20 / z_near) (z_20: 20th percentile of the real depth of the
-   * first frame; z_near: the nearest the objects' centres come to the scenario's
-   * camera), so they keep their image size and speed and pass in front of most of the
-   * real scene; from there they move rigidly in the recording's world, time taken from
-   * the stamps. An object pixel is visible where the real depth is missing or farther;
-   * visible pixels get the object's colour times the ratio of the real to the
-   * synthetic first frame's mean brightness, and depth through DepthSensorModel (its
-   * edges and shadows seeing the real depth around them). Every other pixel keeps the
-   * recording's RGB and depth values exactly. Labels: object id on its visible pixels
-   * while it moves, else 0. No motion blur (it would smear into real pixels).
-   * Outputs as writeSequence: rgb/, depth/, labels/, rgb.txt, depth.txt, objects.txt
-   * (object-to-world in the recording's world), and groundtruth.txt = the recording's.
-   * \param[in] folder must not exist or be empty; nothing existing is overwritten
-   * \throws std::invalid_argument when the scenario has no objects
-   * \throws pcl::IOException when the recording cannot be read (missing or wrong-type
-   *         image, no ground truth at a stamp) or the folder cannot be written
-   */
-  void writeComposite(const CompositeOptions& composite,
-                      const std::string& folder) const;
-
 private:
+  friend class SceneCompositor; // renders the objects only, into real frames
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -4,7 +4,7 @@
 
 #include <dynvo/common/camera.h>
 #include <dynvo/common/export.h>
-#include <dynvo/io/trajectory_io.h>
+#include <dynvo/common/trajectory.h>
 
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>

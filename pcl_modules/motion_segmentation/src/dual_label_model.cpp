@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Dual-mode per-cell label model: compensation, update, swap, read-out (ALGORITHM.md §5, §6).
+// Dual-mode per-cell label model: compensation, update, swap, read-out (docs/algorithm.md §5, §6).
 #include <dynvo/motion_segmentation/dual_label_model.h>
 
 #include <algorithm>

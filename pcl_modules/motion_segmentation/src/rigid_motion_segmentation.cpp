@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Explicit instantiations of RigidMotionSegmentation (STYLE.md §2.4).
+// Explicit instantiations of RigidMotionSegmentation (docs/style.md §2.4).
 #include <dynvo/motion_segmentation/impl/rigid_motion_segmentation.hpp>
 
 #include <pcl/point_types.h>

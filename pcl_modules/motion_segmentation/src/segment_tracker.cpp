@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Motion segment tracking (ALGORITHM.md §4-§6).
+// Motion segment tracking (docs/algorithm.md §4-§6).
 #include <dynvo/motion_segmentation/segment_tracker.h>
 
 #include <dynvo/common/conventions.h>

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Two-frame rigid motion segmentation (ALGORITHM.md §3).
+// Two-frame rigid motion segmentation (docs/algorithm.md §3).
 #include <dynvo/motion_segmentation/spatial_segmentation.h>
 
 #include <dynvo/common/rigid_fit.h>
@@ -35,7 +35,7 @@ rigidError(const Eigen::Matrix3f& R,
   return (R * a + t - b).squaredNorm();
 }
 
-/// Least-squares fit (ALGORITHM.md §2) of b = H a on the listed points; false when degenerate.
+/// Least-squares fit (docs/algorithm.md §2) of b = H a on the listed points; false when degenerate.
 bool
 fitRigidMotion(const std::vector<Eigen::Vector3f>& a,
                const std::vector<Eigen::Vector3f>& b,

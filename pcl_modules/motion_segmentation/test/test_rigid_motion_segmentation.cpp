@@ -2,7 +2,8 @@
 // RigidMotionSegmentation<PointT>: contract, identity, known motion, typed tests.
 #include <dynvo/motion_segmentation/rigid_motion_segmentation.h>
 
-#include "synthetic_flow.h"
+#include "support/pose_compare.h"
+#include "support/synthetic_flow.h"
 
 #include <pcl/point_types.h>
 
@@ -62,8 +63,8 @@ TYPED_TEST(RigidMotionSegmentationTyped, KnownMotionsGivePixelSegments)
   EXPECT_NEAR(static_cast<double>(segments[1].indices.size()), 1600.0 * 6.0 / 7.0, 2.0);
   const Eigen::Matrix4d motion = segmentation.getMotions()[1].template cast<double>();
   // Float storage of the motion: 1e-6 relative, far below the 1 mm / 0.1 deg tolerances.
-  EXPECT_LT(dynvo::test::translationDifference(motion, T_object), 1e-3);
-  EXPECT_LT(dynvo::test::rotationDifferenceDeg(motion, T_object), 0.1);
+  EXPECT_LT(dynvo::test::translationError(motion, T_object), 1e-3);
+  EXPECT_LT(dynvo::test::rotationError(motion, T_object), dynvo::test::radians(0.1));
 }
 
 TYPED_TEST(RigidMotionSegmentationTyped, SameFrameTwiceGivesOneStaticSegment)
@@ -105,7 +106,17 @@ TEST(RigidMotionSegmentationDeterminism, SameSeedSameOutputForOneAndTwoThreads)
   };
   const auto one = run(1);
   const auto two = run(2);
+  // Not vacuous: the background and the object were both found, with pixels and one
+  // motion each (two empty results would compare equal too).
+  ASSERT_GE(one.first.size(), 2u);
+  ASSERT_EQ(one.second.size(), one.first.size());
+  for (const pcl::PointIndices& segment : one.first)
+    EXPECT_FALSE(segment.indices.empty());
+  EXPECT_TRUE(std::any_of(one.second.begin() + 1, one.second.end(), [&](const auto& H) {
+    return dynvo::test::translationError(H, T_object) < 0.01; // 2 mm noise per axis
+  }));
   ASSERT_EQ(one.first.size(), two.first.size());
+  ASSERT_EQ(one.second.size(), two.second.size());
   for (std::size_t s = 0; s < one.first.size(); ++s)
     EXPECT_EQ(one.first[s].indices, two.first[s].indices);
   for (std::size_t s = 0; s < one.second.size(); ++s)

@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Dual-mode model, compensation, matching and tracking (ALGORITHM.md §4-§6).
+// Dual-mode model, compensation, matching and tracking (docs/algorithm.md §4-§6).
 #include <dynvo/motion_segmentation/dual_label_model.h>
 #include <dynvo/motion_segmentation/rigid_motion_segmentation.h>
 #include <dynvo/motion_segmentation/segment_tracker.h>
 
-#include "synthetic_flow.h"
+#include "support/pose_compare.h"
+#include "support/synthetic_flow.h"
 
 #include <pcl/point_types.h>
 

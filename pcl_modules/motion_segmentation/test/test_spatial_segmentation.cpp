@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Two-frame rigid motion segmentation (ALGORITHM.md §3) on synthetic flow grids.
+// Two-frame rigid motion segmentation (docs/algorithm.md §3) on synthetic flow grids.
 #include <dynvo/motion_segmentation/spatial_segmentation.h>
 
-#include "synthetic_flow.h"
+#include "support/pose_compare.h"
+#include "support/synthetic_flow.h"
 
 #include <gtest/gtest.h>
 
@@ -86,8 +87,9 @@ TEST(SpatialSegmentation, TwoRigidMotionsAndBackgroundAreRecovered)
     ASSERT_GT(segment, 0);
     // Noise-free input: the fit is exact up to float rounding of the points (~1e-7 m at 3 m).
     const Eigen::Matrix4d& H = result.motions[segment - 1];
-    EXPECT_LT(dynvo::test::translationDifference(H, truth_motions[id - 1]), 1e-3);
-    EXPECT_LT(dynvo::test::rotationDifferenceDeg(H, truth_motions[id - 1]), 0.1);
+    EXPECT_LT(dynvo::test::translationError(H, truth_motions[id - 1]), 1e-3);
+    EXPECT_LT(dynvo::test::rotationError(H, truth_motions[id - 1]),
+              dynvo::test::radians(0.1));
   }
   // The background is the largest segment.
   EXPECT_EQ(bestSegment(result, synthetic.truth, 1).first, 1);
@@ -130,7 +132,7 @@ TEST(SpatialSegmentation, StaticFlowGivesOneSegment)
     // 1 mm noise per axis: |noise|^2 ~ 3e-6 m^2, 10 sigma under th_inlier = 3e-5, so every
     // cell is an inlier.
     EXPECT_EQ(result.sizes[0], COLS * ROWS);
-    EXPECT_LT(dynvo::test::translationDifference(result.motions[0], T_camera), 1e-3);
+    EXPECT_LT(dynvo::test::translationError(result.motions[0], T_camera), 1e-3);
   }
 }
 
@@ -139,7 +141,7 @@ TEST(SpatialSegmentation, TooFewValidCellsGiveNoSegment)
   auto synthetic = dynvo::test::makeSyntheticFlow(COLS, ROWS, CELL, smallIntrinsics(),
                                                   Eigen::Matrix4d::Identity(), {});
   const dynvo::RigidMotionSegmentationParameters params;
-  // Keep 2 m - 1 valid cells: below the 2 m of ALGORITHM.md §3.
+  // Keep 2 m - 1 valid cells: below the 2 m of docs/algorithm.md §3.
   for (std::size_t i = 2 * params.sample_size - 1; i < synthetic.flow->size(); ++i)
     (*synthetic.flow)[i].valid_3d = 0;
   const dynvo::SpatialSegmentationResult result = segmentFlow(synthetic, params);

@@ -14,7 +14,7 @@ namespace dynvo {
 namespace {
 
 constexpr float NaN = std::numeric_limits<float>::quiet_NaN();
-/// ALGORITHM.md §1.1: the 3x3 median is trusted only with at least 5 valid neighbours.
+/// docs/algorithm.md §1.1: the 3x3 median is trusted only with at least 5 valid neighbours.
 constexpr int MIN_FLYING_NEIGHBOURS = 5;
 
 /// Fills the gap between valid samples l and r (exclusive) of a line with stride `step`.

@@ -59,10 +59,10 @@ namespace detail {
 namespace {
 
 constexpr float NaN = std::numeric_limits<float>::quiet_NaN();
-/// ALGORITHM.md §1.2: the 3x3 median replacing a missing centre depth needs 3 valid neighbours.
+/// docs/algorithm.md §1.2: the 3x3 median replacing a missing centre depth needs 3 valid neighbours.
 constexpr int MIN_CENTRE_NEIGHBOURS = 3;
 
-/// Depth b_i at the integer cell centre, or NaN (ALGORITHM.md §1.2).
+/// Depth b_i at the integer cell centre, or NaN (docs/algorithm.md §1.2).
 float
 centreDepth(const std::vector<float>& depth, int width, int height, int u, int v)
 {
@@ -84,7 +84,7 @@ centreDepth(const std::vector<float>& depth, int width, int height, int u, int v
   return values[n / 2];
 }
 
-/// Depth a_i at a sub-pixel position inside [0, width-2] x [0, height-2] (ALGORITHM.md §1.2).
+/// Depth a_i at a sub-pixel position inside [0, width-2] x [0, height-2] (docs/algorithm.md §1.2).
 float
 trackedDepth(const std::vector<float>& depth, int width, cv::Point2f p, float tau_edge)
 {

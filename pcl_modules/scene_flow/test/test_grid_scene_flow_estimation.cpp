@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <dynvo/scene_flow/grid_scene_flow_estimation.h>
 
-#include "textured_scene.h"
+#include "support/pose_compare.h"
+#include "support/synthetic_scene.h"
 
 #include <pcl/point_types.h>
 
@@ -19,10 +20,8 @@ namespace {
 
 using dynvo::CameraIntrinsics;
 using dynvo::PointFlow;
-using dynvo::test::TexturedQuad;
+using dynvo::test::SceneBox;
 using FlowCloud = pcl::PointCloud<PointFlow>;
-
-constexpr double PI = 3.14159265358979323846;
 
 /// The "default" preset scaled from 640x480 to the test image size.
 CameraIntrinsics
@@ -36,30 +35,21 @@ Eigen::Isometry3d
 pose(double rx_deg, double ry_deg, double rz_deg, double tx, double ty, double tz)
 {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = (Eigen::AngleAxisd(rz_deg * PI / 180.0, Eigen::Vector3d::UnitZ()) *
-                Eigen::AngleAxisd(ry_deg * PI / 180.0, Eigen::Vector3d::UnitY()) *
-                Eigen::AngleAxisd(rx_deg * PI / 180.0, Eigen::Vector3d::UnitX()))
+  using dynvo::test::radians;
+  T.linear() = (Eigen::AngleAxisd(radians(rz_deg), Eigen::Vector3d::UnitZ()) *
+                Eigen::AngleAxisd(radians(ry_deg), Eigen::Vector3d::UnitY()) *
+                Eigen::AngleAxisd(radians(rx_deg), Eigen::Vector3d::UnitX()))
                    .toRotationMatrix();
   T.translation() = Eigen::Vector3d(tx, ty, tz);
   return T;
 }
 
 /// A static room seen from about 1.2-2 m: a back wall and a slanted board in front of it.
-std::vector<TexturedQuad>
+std::vector<SceneBox>
 staticRoom()
 {
-  TexturedQuad wall;
-  wall.T_world_quad = pose(0, 0, 0, 0, 0, 2.0);
-  wall.half_width = 3.0;
-  wall.half_height = 2.5;
-  wall.seed = 1;
-  TexturedQuad board;
-  board.T_world_quad = pose(10, -25, 0, -0.35, 0.1, 1.4);
-  board.half_width = 0.35;
-  board.half_height = 0.3;
-  board.seed = 2;
-  board.id = 1;
-  return {wall, board};
+  return {dynvo::test::texturedQuad(pose(0, 0, 0, 0, 0, 2.0), 3.0, 2.5, 1),
+          dynvo::test::texturedQuad(pose(10, -25, 0, -0.35, 0.1, 1.4), 0.35, 0.3, 2)};
 }
 
 double
@@ -102,13 +92,44 @@ expectCellContract(const FlowCloud& flow)
   }
 }
 
-/// Byte-wise equality (NaN fields compare equal when their bits do).
+/// The same float, bit for bit (so NaN equals NaN, but 0 differs from -0).
+bool
+sameBits(float a, float b)
+{
+  std::uint32_t x = 0, y = 0;
+  std::memcpy(&x, &a, sizeof(x));
+  std::memcpy(&y, &b, sizeof(y));
+  return x == y;
+}
+
+/// Field-by-field bitwise equality of two flow grids (struct padding is not compared).
 bool
 identical(const FlowCloud& a, const FlowCloud& b)
 {
-  return a.width == b.width && a.height == b.height &&
-         std::memcmp(a.points.data(), b.points.data(), a.size() * sizeof(PointFlow)) ==
-             0;
+  if (a.width != b.width || a.height != b.height || a.size() != b.size())
+    return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const PointFlow &p = a[i], &q = b[i];
+    for (const auto field :
+         {&PointFlow::x, &PointFlow::y, &PointFlow::z, &PointFlow::prev_x,
+          &PointFlow::prev_y, &PointFlow::prev_z, &PointFlow::u, &PointFlow::v,
+          &PointFlow::prev_u, &PointFlow::prev_v, &PointFlow::weight})
+      if (!sameBits(p.*field, q.*field))
+        return false;
+    if (p.valid_2d != q.valid_2d || p.valid_3d != q.valid_3d)
+      return false;
+  }
+  return true;
+}
+
+/// Cells with a valid 3D flow.
+std::size_t
+validCells(const FlowCloud& flow)
+{
+  return static_cast<std::size_t>(
+      std::count_if(flow.begin(), flow.end(), [](const PointFlow& f) {
+        return f.valid_3d != 0;
+      }));
 }
 
 template <typename PointT> class GridSceneFlowTest : public ::testing::Test {
@@ -119,7 +140,7 @@ protected:
 
   GridSceneFlowTest() { estimation_.setCameraIntrinsics(intrinsics_); }
 
-  dynvo::test::RenderedView<PointT> view(const std::vector<TexturedQuad>& quads,
+  dynvo::test::RenderedView<PointT> view(const std::vector<SceneBox>& quads,
                                          const Eigen::Isometry3d& T_world_camera) const
   {
     return dynvo::test::render<PointT>(quads, T_world_camera, intrinsics_, WIDTH,
@@ -211,12 +232,8 @@ TYPED_TEST(GridSceneFlowTest, MovingObjectCellsCarryTheObjectMotion)
 {
   auto scene = staticRoom();
   scene.resize(1); // the wall only
-  TexturedQuad box;
-  box.T_world_quad = pose(0, 0, 0, 0.1, 0.0, 1.2);
-  box.half_width = 0.35;
-  box.half_height = 0.25;
-  box.seed = 5;
-  box.id = 7;
+  const SceneBox box =
+      dynvo::test::texturedQuad(pose(0, 0, 0, 0.1, 0.0, 1.2), 0.35, 0.25, 5, true);
   const Eigen::Isometry3d T_world_curr = pose(0, 0.5, 0, 0.01, 0, 0);
   const auto previous = [&] {
     auto quads = scene;
@@ -225,11 +242,9 @@ TYPED_TEST(GridSceneFlowTest, MovingObjectCellsCarryTheObjectMotion)
   }();
   // The object moves 4 cm and turns 3 deg about its own z axis, far beyond the static motion.
   const Eigen::Isometry3d motion = pose(0, 0, 3, -0.03, 0.02, -0.01);
-  TexturedQuad moved = box;
-  moved.T_world_quad = motion * box.T_world_quad;
   auto quads = scene;
-  quads.push_back(moved);
-  auto current = this->view(quads, T_world_curr);
+  quads.push_back(box);
+  auto current = this->view(dynvo::test::moveBoxes(quads, motion), T_world_curr);
   // A missing-depth block (48x32 px, wider than any fillable hole) over the top-left cells.
   for (std::uint32_t v = 0; v < 32; ++v)
     for (std::uint32_t u = 0; u < 48; ++u) {
@@ -249,7 +264,7 @@ TYPED_TEST(GridSceneFlowTest, MovingObjectCellsCarryTheObjectMotion)
     }
     const auto pixel =
         static_cast<std::size_t>(f.v) * this->WIDTH + static_cast<std::size_t>(f.u);
-    if (current.ids[pixel] != 1)
+    if (current.ids[pixel] != 1) // the box, second in the list
       continue;
     ++object_cells;
     if (!f.valid_3d)
@@ -287,6 +302,8 @@ TYPED_TEST(GridSceneFlowTest, ShiftCurrentToPreviousMatchesAFreshComputation)
   FlowCloud expected;
   fresh.compute(expected);
   ASSERT_FALSE(expected.empty());
+  EXPECT_GE(validCells(expected),
+            60u); // of 70: the comparison is not between empty grids
   EXPECT_TRUE(identical(this->flow_, expected));
 
   // A parameter change after the shift must rebuild both frames, not reuse stale pyramids.
@@ -304,8 +321,18 @@ TYPED_TEST(GridSceneFlowTest, ResultIsIdenticalForOneAndTwoThreads)
   const auto current = this->view(scene, pose(0.3, 0.6, 0, 0.015, 0, 0.01));
   this->run(previous.cloud, current.cloud);
   const FlowCloud single = this->flow_;
+  // Not vacuous: the camera moved and most of the 10x7 cells were tracked in 3D with a
+  // non-zero flow (two empty grids would compare equal too).
+  ASSERT_EQ(single.size(), 70u);
+  EXPECT_GE(validCells(single), 60u);
+  EXPECT_GT(std::count_if(single.begin(), single.end(),
+                          [](const PointFlow& f) {
+                            return f.valid_2d && std::abs(f.prev_u - f.u) > 0.5f;
+                          }),
+            30);
   this->estimation_.setNumberOfThreads(2);
   this->run(previous.cloud, current.cloud);
+  EXPECT_EQ(validCells(this->flow_), validCells(single));
   EXPECT_TRUE(identical(this->flow_, single));
 }
 

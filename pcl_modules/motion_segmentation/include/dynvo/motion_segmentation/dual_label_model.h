@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Per-cell dual-mode (apparent / candidate) label model with warping (ALGORITHM.md §5, §6).
+// Per-cell dual-mode (apparent / candidate) label model with warping (docs/algorithm.md §5, §6).
 #pragma once
 
 #include <dynvo/common/export.h>

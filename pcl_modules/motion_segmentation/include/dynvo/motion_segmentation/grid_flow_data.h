@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Structure-of-arrays view of one grid scene flow (ALGORITHM.md §0 GridFlow).
+// Structure-of-arrays view of one grid scene flow (docs/algorithm.md §1.2).
 #pragma once
 
 #include <dynvo/common/export.h>

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Rigid motion segmentation of a grid scene flow, tracked over a sequence (ALGORITHM.md §2-§6).
+// Rigid motion segmentation of a grid scene flow, tracked over a sequence (docs/algorithm.md §2-§6).
 #pragma once
 
 #include <dynvo/common/camera.h>
@@ -30,7 +30,7 @@ namespace dynvo {
  * Input: the current organized cloud (frame k, where the grid is anchored) and the grid scene
  * flow from frame k-1 to k (GridSceneFlowEstimation). Every frame, rigid motion hypotheses are
  * sampled on the flow (entropy-weighted), refined, clustered by DBSCAN and turned into
- * segments (ALGORITHM.md §3). With tracking on (default), the segments are matched against
+ * segments (docs/algorithm.md §3). With tracking on (default), the segments are matched against
  * the last label maps to get persistent ids, label 1 being the static background (§4), and a
  * dual-mode per-cell model filters the labels over time (§5, §6).
  *
@@ -96,10 +96,10 @@ public:
   /// Output label per grid cell (row-major, cols x rows of the flow): 0 none, 1 static, 2.. objects.
   const std::vector<std::uint8_t>& getCellLabels() const { return cell_labels_; }
 
-  /// The two-frame segmentation of the last segment() (G, one motion per segment, ALGORITHM.md §3).
+  /// The two-frame segmentation of the last segment() (G, one motion per segment, docs/algorithm.md §3).
   const SpatialSegmentationResult& getSpatialSegmentation() const { return spatial_; }
 
-  /// The tracker state (tracked labels Ghat, model labels L, ALGORITHM.md §4-§6).
+  /// The tracker state (tracked labels Ghat, model labels L, docs/algorithm.md §4-§6).
   const SegmentTracker& getTracker() const { return tracker_; }
 
   /** \brief Forgets the sequence (label buffer and models): the next segment() starts a new

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Motion segment tracking: matching, static-background guard, dual model (ALGORITHM.md §4-§6).
+// Motion segment tracking: matching, static-background guard, dual model (docs/algorithm.md §4-§6).
 #pragma once
 
 #include <dynvo/common/camera.h>
@@ -34,7 +34,7 @@ DYNVO_EXPORTS double correlateLabelMaps(const std::vector<std::uint8_t>& segment
                                         int labels,
                                         std::vector<double>& correlation);
 
-/** \brief Tracker turning per-frame segments into persistent labels (ALGORITHM.md §4-§6).
+/** \brief Tracker turning per-frame segments into persistent labels (docs/algorithm.md §4-§6).
  *
  * Per frame: warps the buffered label maps and the models into the current grid with the
  * scene flow, matches the segments (label 1 = static background, guarded by the

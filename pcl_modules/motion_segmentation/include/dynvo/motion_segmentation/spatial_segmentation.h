@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Two-frame rigid motion segmentation: hypotheses, refinement, DBSCAN, labels (ALGORITHM.md §3).
+// Two-frame rigid motion segmentation: hypotheses, refinement, DBSCAN, labels (docs/algorithm.md §3).
 #pragma once
 
 #include <dynvo/common/export.h>
@@ -14,13 +14,13 @@
 
 namespace dynvo {
 
-/// One accepted motion hypothesis (ALGORITHM.md §3.3).
+/// One accepted motion hypothesis (docs/algorithm.md §3.3).
 struct MotionHypothesis {
   Eigen::Matrix4d T_curr_prev = Eigen::Matrix4d::Identity(); ///< H mapping a_i to b_i
   std::vector<int> inliers; ///< points with E_i(H) <= th_inlier, ascending indices
 };
 
-/// Output of SpatialSegmenter::segment (ALGORITHM.md §3.6, SegResult).
+/// Output of SpatialSegmenter::segment (docs/algorithm.md §3.6).
 struct SpatialSegmentationResult {
   std::vector<std::uint8_t>
       labels; ///< G_i per cell: 0 = no valid motion, 1..g by size (1 largest)
@@ -49,7 +49,7 @@ struct SpatialSegmentationResult {
 DYNVO_EXPORTS std::vector<int>
 dbscan(const std::vector<double>& distances, int count, double epsilon, int min_points);
 
-/** \brief Motion-field distance of two hypotheses (metres, ALGORITHM.md §3.5):
+/** \brief Motion-field distance of two hypotheses (metres, docs/algorithm.md §3.5):
  * sqrt(mean over i in I_x u I_y of ||(R_x - R_y) a_i + (t_x - t_y)||^2); 0 when both
  * are empty.
  * \param[in] a points the inlier indices refer to (metres, previous camera frame)
@@ -58,7 +58,7 @@ DYNVO_EXPORTS double motionFieldDistance(const MotionHypothesis& x,
                                          const MotionHypothesis& y,
                                          const std::vector<Eigen::Vector3f>& a);
 
-/** \brief The two-frame segmentation of ALGORITHM.md §3 on the valid_3d cells of a grid.
+/** \brief The two-frame segmentation of docs/algorithm.md §3 on the valid_3d cells of a grid.
  *
  * Entropy-weighted seeds (std::discrete_distribution on a std::mt19937 seeded with
  * params.seed at every call), m - 1 distinct neighbours within r_search cells, a 7-point fit
@@ -66,8 +66,8 @@ DYNVO_EXPORTS double motionFieldDistance(const MotionHypothesis& x,
  * the three stopping rules, DBSCAN with the motion-field distance, and labelling with
  * small-segment removal. The scratch buffers are kept between calls. Deterministic: the
  * result depends on the input and params only. Single-threaded on purpose: each per-cell
- * loop is a few microseconds, less than an OpenMP fork/join (with another process on the
- * cores, libgomp's spinning joins cost 700 ms per frame with 2 threads, measured).
+ * loop is a few microseconds, less than an OpenMP fork/join (measured: NOTES.md,
+ * decision 11).
  */
 class DYNVO_EXPORTS SpatialSegmenter {
 public:
@@ -92,7 +92,7 @@ private:
   std::vector<int>
   clusterHypotheses(const RigidMotionSegmentationParameters& params) const;
 
-  /// Labels the grid from the clusters and fills result (ALGORITHM.md §3.6).
+  /// Labels the grid from the clusters and fills result (docs/algorithm.md §3.6).
   void label(const std::vector<int>& clusters,
              const RigidMotionSegmentationParameters& params,
              SpatialSegmentationResult& result);

@@ -9,7 +9,7 @@
 
 namespace dynvo {
 
-/** \brief Depth preprocessing of ALGORITHM.md §1.1 (Lee, Son & Kim, IROS 2019: "narrow holes
+/** \brief Depth preprocessing of docs/algorithm.md §1.1 (Lee, Son & Kim, IROS 2019: "narrow holes
  * are filled from nearby similar values, abnormally high or low depths are removed").
  *
  * Works on a row-major float depth map in metres where NaN means "no measurement", in three steps:
@@ -20,16 +20,16 @@ namespace dynvo {
  * 3. narrow holes: a row pass, then a column pass. A run of at most max_hole_width NaN pixels with
  *    valid ends zL, zR is filled by linear interpolation when |zL - zR| <= hole_fill_tolerance *
  *    min(zL, zR); otherwise it is a depth discontinuity and stays NaN.
- * Cost O(width * height), about 1 ms at 640x480 on one thread.
+ * Cost O(width * height) (timings: pcl_modules/scene_flow/NOTES.md).
  * \code
- * dynvo::DepthPreprocessing preprocessing;          // ALGORITHM.md §9 defaults
+ * dynvo::DepthPreprocessing preprocessing;          // docs/algorithm.md §9 defaults
  * std::vector<float> clean;
  * preprocessing.apply(depth_metres, 640, 480, clean);
  * \endcode
  */
 class DYNVO_EXPORTS DepthPreprocessing {
 public:
-  /// Knobs of ALGORITHM.md §1.1 / §9.
+  /// Knobs of docs/algorithm.md §1.1 / §9.
   struct Parameters {
     float min_depth = 0.3f; ///< z_min (metres): nearer depths are invalid
     float max_depth = 5.0f; ///< z_max (metres): farther depths are invalid

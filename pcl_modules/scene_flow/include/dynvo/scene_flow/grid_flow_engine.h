@@ -49,7 +49,7 @@ public:
   /// The current slot becomes the previous one (no copy); the current slot is then stale.
   void shiftCurrentToPrevious();
 
-  /** \brief Grid scene flow from the previous to the current slot (ALGORITHM.md §1.2).
+  /** \brief Grid scene flow from the previous to the current slot (docs/algorithm.md §1.2).
    * Both slots must have been prepared with the same size and params.
    * \param[out] flow organized (width / cell_size) x (height / cell_size) cloud
    */

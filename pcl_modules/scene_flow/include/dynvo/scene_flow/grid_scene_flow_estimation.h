@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Grid-based scene flow between two organized RGB-D clouds (ALGORITHM.md §1).
+// Grid-based scene flow between two organized RGB-D clouds (docs/algorithm.md §1).
 #pragma once
 
 #include <dynvo/common/camera.h>

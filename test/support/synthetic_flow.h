@@ -1,11 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Synthetic grid scene flows with known rigid motions per region, for the unit tests.
+// Synthetic grid scene flows with known rigid motions per region: flow-level input for the
+// segmentation tests, built cell by cell without rendering (support/synthetic_scene.h renders
+// images; this skips the flow estimation so that the segmentation is tested alone).
 #pragma once
 
 #include <dynvo/common/camera.h>
 #include <dynvo/common/point_types.h>
 
-#include "support/rigid_motion.h"
+#include "support/pose_compare.h"
 
 #include <pcl/point_cloud.h>
 
@@ -18,22 +20,6 @@
 #include <vector>
 
 namespace dynvo::test {
-
-/// Rotation angle (degrees) of T_a^-1 T_b.
-inline double
-rotationDifferenceDeg(const Eigen::Matrix4d& T_a, const Eigen::Matrix4d& T_b)
-{
-  const Eigen::Matrix3d R =
-      T_a.topLeftCorner<3, 3>().transpose() * T_b.topLeftCorner<3, 3>();
-  return Eigen::AngleAxisd(R).angle() * 180.0 / M_PI;
-}
-
-/// Translation difference (metres) of two motions.
-inline double
-translationDifference(const Eigen::Matrix4d& T_a, const Eigen::Matrix4d& T_b)
-{
-  return (T_a.topRightCorner<3, 1>() - T_b.topRightCorner<3, 1>()).norm();
-}
 
 /// A rectangle of grid cells [col0, col1) x [row0, row1) at depth z with its own motion.
 struct FlowRegion {

@@ -7,7 +7,7 @@
 // per-pixel labels (0 static, k object k while it moves) of the cell; IoU is taken over
 // the cells with valid_3d flow, the only ones the segmentation can label.
 // Depth noise is off: with the Kinect model (sigma = 1.2e-3 z^2, 11 mm at 3 m) the fixed
-// th_inlier of 5.5 mm rejects most points beyond 2 m (ALGORITHM.md §12), and the IoU on
+// th_inlier of 5.5 mm rejects most points beyond 2 m (docs/algorithm.md §12), and the IoU on
 // static_two falls to about 0.02.
 #include <dynvo/io/frame.h>
 #include <dynvo/motion_segmentation/rigid_motion_segmentation.h>
@@ -245,7 +245,7 @@ TEST(SegmentationSequences, StopAndGo)
   const int max_age = static_cast<int>(params.max_age);
   const std::vector<FrameRecord> records = runSequence("stop_and_go", 50, 85, true);
   // The restart is counted from the first frame where the object moves by the inlier radius
-  // sqrt(th_inlier) = 5.5 mm: slower motion cannot be told from the background (ALGORITHM.md
+  // sqrt(th_inlier) = 5.5 mm: slower motion cannot be told from the background (docs/algorithm.md
   // §12), and the 0.25 s speed ramp takes 4 frames to get there (0.1, 1, 2.5, 4.5 mm).
   const double detectable = std::sqrt(params.inlier_threshold);
   int restart = -1, stop = -1;
@@ -283,7 +283,7 @@ TEST(SegmentationSequences, LargeOccluderDoesNotTakeTheBackgroundLabel)
   // moving_occluder: moving camera; the box approaches, covers more valid cells than the
   // background from about frame 80 on (89 % at its nearest, frame 157), slows to a halt
   // there and recedes. While slow it moves less than the 5.5 mm inlier radius relative to
-  // the background, so the segmentation merges the two (ALGORITHM.md §12); without
+  // the background, so the segmentation merges the two (docs/algorithm.md §12); without
   // object_separation_ratio the box became background after alpha_max frames and kept
   // label 1 once it sped up again (held on 48 of 125 frames, the background lost label 1
   // entirely from frame 193).
