@@ -35,6 +35,24 @@ splitKey(const std::string& key)
   return parts;
 }
 
+/// Opens a YAML file; \throws pcl::IOException "path: failure" or "path: error (OpenCV's)"
+void
+openStorage(cv::FileStorage& fs,
+            const std::string& path,
+            int mode,
+            const std::string& failure,
+            const std::string& error)
+{
+  try {
+    fs.open(path, mode | cv::FileStorage::FORMAT_YAML);
+  }
+  catch (const cv::Exception& e) {
+    throw pcl::IOException(path + ": " + error + " (" + e.err + ")");
+  }
+  if (!fs.isOpened())
+    throw pcl::IOException(path + ": " + failure);
+}
+
 } // namespace
 
 const ParameterTable<PipelineOptions>&
@@ -94,14 +112,8 @@ void
 loadPipelineConfig(const std::string& path, PipelineOptions& options)
 {
   cv::FileStorage fs;
-  try {
-    fs.open(path, cv::FileStorage::READ | cv::FileStorage::FORMAT_YAML);
-  }
-  catch (const cv::Exception& e) {
-    throw pcl::IOException(path + ": not a readable YAML file (" + e.err + ")");
-  }
-  if (!fs.isOpened())
-    throw pcl::IOException(path + ": cannot open configuration file");
+  openStorage(fs, path, cv::FileStorage::READ, "cannot open configuration file",
+              "not a readable YAML file");
 
   const auto fail = [&](const std::string& key, const std::string& problem) {
     throw pcl::IOException(path + ": " + key + ": " + problem);
@@ -182,14 +194,8 @@ void
 writePipelineConfig(const std::string& path, const PipelineOptions& options)
 {
   cv::FileStorage fs;
-  try {
-    fs.open(path, cv::FileStorage::WRITE | cv::FileStorage::FORMAT_YAML);
-  }
-  catch (const cv::Exception& e) {
-    throw pcl::IOException(path + ": cannot write configuration file (" + e.err + ")");
-  }
-  if (!fs.isOpened())
-    throw pcl::IOException(path + ": cannot write configuration file");
+  openStorage(fs, path, cv::FileStorage::WRITE, "cannot write configuration file",
+              "cannot write configuration file");
   std::vector<std::string> open_maps; // the maps around the last key, outermost first
   for (const auto& field : pipelineConfigTable().fields()) {
     std::vector<std::string> parts = splitKey(field.name);
