@@ -266,15 +266,8 @@ public:
     throw std::logic_error("[dynvo::ParameterTable::field] no field '" + name + "'");
   }
 
-  /// \throws std::invalid_argument("prefix name must be ..., got ...") when the field is
-  ///         out of its own range in s
-  void
-  checkField(const Struct& s, const std::string& name, const std::string& prefix) const
-  {
-    check(field(name), s, prefix);
-  }
-
-  /// checkField() for every field, in table order.
+  /// \throws std::invalid_argument("prefix name must be ..., got ...") naming the first
+  ///         field, in table order, that is out of its own range in s
   void checkAll(const Struct& s, const std::string& prefix) const
   {
     for (const Field& f : fields_)
@@ -297,19 +290,21 @@ private:
 /** \brief Declares setName(value) and getName() for the field `field` (a path such as
  * `cell_size` or `depth.min_depth`) of the class's `Parameters params_`.
  *
- * The setter checks the field's own range from Parameters::table() and throws
+ * The setter checks the ranges of Parameters::table() and throws
  * std::invalid_argument("[dynvo::<class>::setName] field must be ..., got ...") keeping the
- * old value; then it calls the class's assignParameters(updated). Rules that tie several
- * fields (Parameters::validate()) are checked when the parameters are used, so setters work
- * in any order. The class provides getClassName(), params_ and assignParameters().
+ * old value; then it calls the class's assignParameters(updated). Every other field is in its
+ * range already (setParameters() and the setters keep it so), so only the new value can
+ * fail. Rules that tie several fields (Parameters::validate()) are checked when the
+ * parameters are used, so setters work in any order. The class provides getClassName(),
+ * params_ and assignParameters().
  */
 #define DYNVO_PARAMETER_ACCESSORS(Name, field)                                         \
   void set##Name(decltype(std::declval<Parameters&>().field) value)                    \
   {                                                                                    \
     Parameters updated = params_;                                                      \
     updated.field = value;                                                             \
-    Parameters::table().checkField(                                                    \
-        updated, #field, "[dynvo::" + this->getClassName() + "::set" #Name "]");       \
+    Parameters::table().checkAll(updated, "[dynvo::" + this->getClassName() +          \
+                                              "::set" #Name "]");                      \
     assignParameters(updated);                                                         \
   }                                                                                    \
   decltype(std::declval<Parameters&>().field) get##Name() const                        \

@@ -14,7 +14,8 @@ RigidMotionSegmentationParameters::table()
   using R = FieldRange;
   static_assert(AGGREGATE_FIELD_COUNT<P> == 24, "every field of P needs a row below");
   static const ParameterTable<P> table(std::vector<ParameterTable<P>::Field>{
-      makeField("cell_size", &P::cell_size, R::atLeast(2), "w_grid, px"),
+      makeField("cell_size", &P::cell_size, R::atLeast(2),
+                "w_grid, px, = scene flow's"),
       makeField("max_hypotheses", &P::max_hypotheses, R::closed(1, 254), "h_max"),
       makeField("max_trials", &P::max_trials, R::atLeast(1),
                 "T_max, >= max_hypotheses"),
@@ -45,7 +46,7 @@ RigidMotionSegmentationParameters::table()
                 "k_sep, 0 = off"),
       makeField("object_separation_hold", &P::object_separation_hold, R::atLeast(1),
                 "k_hold, <= k_sep"),
-      makeField("seed", &P::seed, R::any(), "hypothesis sampling seed"),
+      makeField("seed", &P::seed, R::closed(0, 4294967295.0), "sampling seed"),
   });
   return table;
 }
