@@ -31,6 +31,14 @@ const char* const USAGE =
     "dynvo_odometry (-tum_dir DIR | -pcd_dir DIR | -oni FILE) [-out trajectory.txt] "
     "[-labels_dir DIR] [-objects FILE] [options]";
 
+/// The default of a configuration key, as written in a -config file.
+std::string
+defaultOf(const std::string& key)
+{
+  return dynvo::app::pipelineConfigTable().field(key).text(
+      dynvo::app::PipelineOptions());
+}
+
 std::vector<dynvo::app::Option>
 options()
 {
@@ -47,11 +55,15 @@ options()
           {"objects", "FILE",
            "write 'timestamp id n_pixels tx ty tz qx qy qz qw' per object"},
           {"max_frames", "N", "stop after N frames (default: all)"},
-          {"threads", "N", "worker threads (default 1); results do not depend on it"},
-          {"seed", "S", "hypothesis sampling seed (default 0)"},
+          {"threads", "N",
+           "worker threads (default " + defaultOf("pipeline.threads") +
+               "); results do not depend on it"},
+          {"seed", "S",
+           "hypothesis sampling seed (default " + defaultOf("segmentation.seed") + ")"},
           {"no_segmentation", "", "ablation: every valid flow cell counts as static"},
           {"refine", "none|icp|gicp",
-           "refinement of the static registration (default none)"},
+           "refinement of the static registration (default " +
+               defaultOf("registration.refinement") + ")"},
           {"render_dir", "DIR",
            "render label-coloured views and trajectory.png (needs X: xvfb-run -a)"},
           {"render_every", "N", "render every N-th frame (default 10)"},
@@ -77,14 +89,13 @@ pipelineOptions(const dynvo::app::Arguments& args)
       args.integer("seed", options.segmentation.seed, 0, 4294967295L));
   if (args.has("no_segmentation"))
     options.use_segmentation = false;
-  const std::string refine = args.string("refine", "none");
-  const char* const methods[] = {"none", "icp", "gicp"};
-  const auto method = std::find(std::begin(methods), std::end(methods), refine);
-  if (method == std::end(methods))
+  const auto& refinement =
+      dynvo::app::pipelineConfigTable().field("registration.refinement");
+  const std::string refine = args.string("refine", refinement.text(options));
+  const int method = refinement.choiceIndex(refine);
+  if (method < 0)
     throw UsageError("-refine must be none, icp or gicp, got '" + refine + "'");
-  if (args.has("refine"))
-    options.registration.refinement =
-        static_cast<dynvo::RegistrationRefinement>(method - std::begin(methods));
+  refinement.set(options, method);
   options.validate();
   return options;
 }
@@ -161,7 +172,10 @@ main(int argc, char** argv)
   return dynvo::app::runApp(USAGE, [&] {
     const dynvo::app::Arguments args(argc, argv, options());
     if (args.helpRequested()) {
-      std::printf("Usage: %s\n\n%s", USAGE, args.optionsHelp().c_str());
+      std::printf(
+          "Usage: %s\n\n%s\nConfiguration keys (-config FILE) and defaults:\n%s", USAGE,
+          args.optionsHelp().c_str(),
+          dynvo::app::pipelineConfigHelp(dynvo::app::PipelineOptions()).c_str());
       return 0;
     }
     if (args.has("v"))

@@ -62,6 +62,8 @@ main(int argc, char** argv)
 {
   return dynvo::app::runApp(USAGE, [&] {
     const dynvo::GridSceneFlowParameters defaults;
+    const auto& fb_check_field =
+        dynvo::GridSceneFlowParameters::table().field("forward_backward_check");
     const long hardware_threads = std::max(1U, std::thread::hardware_concurrency());
     const auto text = [](auto value) {
       return std::to_string(value);
@@ -81,7 +83,8 @@ main(int argc, char** argv)
          {"max_pyramid_level", "L",
           "LK pyramid levels above the image (default " +
               text(defaults.max_pyramid_level) + ")"},
-         {"fb_check", "full|local", "forward-backward scheme (default local)"}});
+         {"fb_check", "full|local",
+          "forward-backward scheme (default " + fb_check_field.text(defaults) + ")"}});
     const dynvo::app::Arguments args(argc, argv, options, 0);
     if (args.helpRequested()) {
       std::printf(
@@ -107,12 +110,11 @@ main(int argc, char** argv)
         static_cast<int>(args.integer("window_size", defaults.window_size));
     parameters.max_pyramid_level =
         static_cast<int>(args.integer("max_pyramid_level", defaults.max_pyramid_level));
-    const std::string fb_check = args.string("fb_check", "local");
-    if (fb_check != "full" && fb_check != "local")
+    const std::string fb_check = args.string("fb_check", fb_check_field.text(defaults));
+    const int choice = fb_check_field.choiceIndex(fb_check);
+    if (choice < 0)
       throw dynvo::app::UsageError("-fb_check must be full or local, got " + fb_check);
-    parameters.forward_backward_check = fb_check == "full"
-                                            ? dynvo::ForwardBackwardCheck::full
-                                            : dynvo::ForwardBackwardCheck::local;
+    fb_check_field.set(parameters, choice);
 
     dynvo::GridSceneFlowEstimation<pcl::PointXYZRGB> estimation;
     try {

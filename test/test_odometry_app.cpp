@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // dynvo_odometry as users run it: outputs, closing lines, determinism and bad input.
+#include <dynvo/app/pipeline_config.h>
 #include <dynvo/app/synthesize.h>
 #include <dynvo/io/label_io.h>
 #include <dynvo/io/trajectory_io.h>
@@ -10,6 +11,7 @@
 #include "support/run_command.h"
 #include "support/temp_dir.h"
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -118,6 +120,43 @@ TEST_F(OdometryApp, ConfigRoundTripsAndUnknownKeysAreRejected)
   EXPECT_EQ(bad.exit_code, 1);
   EXPECT_NE(bad.err.find("segmentation.max_hypothesis: unknown key"), std::string::npos)
       << bad.err;
+}
+
+TEST_F(OdometryApp, WrittenConfigReproducesTheRunForEveryField)
+{
+  // Flags and a file with every key of every table off its default: -write_config must
+  // capture all of it, so that -config alone gives the same trajectory, byte for byte.
+  dynvo::app::PipelineOptions changed;
+  for (const auto& field : dynvo::app::pipelineConfigTable().fields()) {
+    const double value = field.get(changed);
+    const double other =
+        field.kind == dynvo::FieldKind::choice
+            ? std::fmod(value + 1.0, static_cast<double>(field.choices.size()))
+            : (field.kind == dynvo::FieldKind::boolean ? 1.0 - value : value);
+    field.set(changed, other);
+  }
+  changed.segmentation.max_hypotheses = 15; // and numbers, within the cross-field rules
+  changed.registration.trim_rounds = 3;
+  changed.scene_flow.depth.max_hole_width = 3;
+  dynvo::app::writePipelineConfig(out_.file("changed.yaml"), changed);
+  const auto succeeds = [this](const std::string& flags) {
+    const auto result = runCommand(run(flags));
+    EXPECT_EQ(result.exit_code, 0) << flags << "\n" << result.err;
+    return result.exit_code == 0;
+  };
+  const std::string flags =
+      "-max_frames 8 -seed 5 -threads 2 -config " + out_.file("changed.yaml");
+  ASSERT_TRUE(succeeds(flags + " -out " + out_.file("a.txt")));
+  ASSERT_TRUE(succeeds(flags + " -write_config " + out_.file("b.yaml")));
+  const std::string reread = "-max_frames 8 -config " + out_.file("b.yaml");
+  ASSERT_TRUE(succeeds(reread + " -out " + out_.file("b.txt")));
+  EXPECT_EQ(dynvo::test::readText(out_.file("a.txt")),
+            dynvo::test::readText(out_.file("b.txt")));
+  EXPECT_FALSE(dynvo::test::readText(out_.file("a.txt")).empty());
+  // Reading the written file and writing it again changes nothing.
+  ASSERT_TRUE(succeeds(reread + " -write_config " + out_.file("c.yaml")));
+  EXPECT_EQ(dynvo::test::readText(out_.file("b.yaml")),
+            dynvo::test::readText(out_.file("c.yaml")));
 }
 
 TEST_F(OdometryApp, CorruptFrameStopsTheRunButKeepsWhatWasComputed)

@@ -71,18 +71,11 @@ PipelineOptions::validate() const
   scene_flow.validate();
   segmentation.validate();
   registration.validate();
-  if (threads == 0)
+  table().checkAll(*this, "[dynvo::app::PipelineOptions]");
+  if (!(min_inlier_threshold <= segmentation.inlier_threshold))
     throw std::invalid_argument(
-        "[dynvo::app::PipelineOptions] threads must be at least 1");
-  if (!(inlier_noise_factor >= 0.0f) ||
-      !(min_inlier_threshold > 0.0f &&
-        min_inlier_threshold <= segmentation.inlier_threshold))
-    throw std::invalid_argument(
-        "[dynvo::app::PipelineOptions] inlier_noise_factor must be >= 0 and "
-        "min_inlier_threshold in (0, segmentation.inlier_threshold]");
-  if (!(static_consensus >= 0.0f))
-    throw std::invalid_argument(
-        "[dynvo::app::PipelineOptions] static_consensus must be >= 0");
+        "[dynvo::app::PipelineOptions] min_inlier_threshold must "
+        "be <= segmentation.inlier_threshold");
   if (segmentation.cell_size != scene_flow.cell_size)
     throw std::invalid_argument(
         "[dynvo::app::PipelineOptions] segmentation cell_size " +

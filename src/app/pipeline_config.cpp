@@ -5,150 +5,168 @@
 
 #include <opencv2/core.hpp>
 
-#include <algorithm>
 #include <functional>
+#include <limits>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 
 namespace dynvo::app {
 
 namespace {
 
-/// Calls visit(section, name, field&) for every configurable field, in file order.
-template <typename Options, typename Visit>
-void
-visitFields(Options& o, Visit&& visit)
+/// The fields of one struct renamed "prefix.name" (same struct, unlike nestFields()).
+std::vector<FieldInfo<PipelineOptions>>
+prefixFields(const std::string& prefix, std::vector<FieldInfo<PipelineOptions>> fields)
 {
-  auto& f = o.scene_flow;
-  visit("scene_flow", "cell_size", f.cell_size);
-  visit("scene_flow.depth", "min_depth", f.depth.min_depth);
-  visit("scene_flow.depth", "max_depth", f.depth.max_depth);
-  visit("scene_flow.depth", "flying_pixel_tolerance", f.depth.flying_pixel_tolerance);
-  visit("scene_flow.depth", "max_hole_width", f.depth.max_hole_width);
-  visit("scene_flow.depth", "hole_fill_tolerance", f.depth.hole_fill_tolerance);
-  visit("scene_flow", "window_size", f.window_size);
-  visit("scene_flow", "max_pyramid_level", f.max_pyramid_level);
-  visit("scene_flow", "max_iterations", f.max_iterations);
-  visit("scene_flow", "epsilon", f.epsilon);
-  visit("scene_flow", "min_eigen_threshold", f.min_eigen_threshold);
-  visit("scene_flow", "forward_backward_threshold", f.forward_backward_threshold);
-  visit("scene_flow", "depth_edge_tolerance", f.depth_edge_tolerance);
-  visit("scene_flow", "max_flow", f.max_flow);
-  visit("scene_flow", "depth_window_radius", f.depth_window_radius);
-  visit("scene_flow", "weight_reference_depth", f.weight_reference_depth);
-  auto& s = o.segmentation;
-  visit("segmentation", "cell_size", s.cell_size);
-  visit("segmentation", "max_hypotheses", s.max_hypotheses);
-  visit("segmentation", "max_trials", s.max_trials);
-  visit("segmentation", "sample_size", s.sample_size);
-  visit("segmentation", "search_radius", s.search_radius);
-  visit("segmentation", "inlier_threshold", s.inlier_threshold);
-  visit("segmentation", "entropy_lambda", s.entropy_lambda);
-  visit("segmentation", "entropy_delta", s.entropy_delta);
-  visit("segmentation", "refine_iterations", s.refine_iterations);
-  visit("segmentation", "entropy_done", s.entropy_done);
-  visit("segmentation", "entropy_saturation", s.entropy_saturation);
-  visit("segmentation", "dbscan_min_points", s.dbscan_min_points);
-  visit("segmentation", "dbscan_epsilon", s.dbscan_epsilon);
-  visit("segmentation", "min_segment_size", s.min_segment_size);
-  visit("segmentation", "tracking", s.tracking);
-  visit("segmentation", "max_labels", s.max_labels);
-  visit("segmentation", "max_age", s.max_age);
-  visit("segmentation", "buffer_length", s.buffer_length);
-  visit("segmentation", "min_correlation", s.min_correlation);
-  visit("segmentation", "static_guard_tolerance", s.static_guard_tolerance);
-  visit("segmentation", "static_min_cells", s.static_min_cells);
-  visit("segmentation", "object_separation_ratio", s.object_separation_ratio);
-  visit("segmentation", "object_separation_hold", s.object_separation_hold);
-  visit("segmentation", "seed", s.seed);
-  auto& r = o.registration;
-  visit("registration", "th_inlier", r.th_inlier);
-  visit("registration", "trim_factor", r.trim_factor);
-  visit("registration", "trim_rounds", r.trim_rounds);
-  visit("registration", "min_correspondences", r.min_correspondences);
-  visit("registration", "refinement", r.refinement);
-  visit("registration", "refinement_max_correspondence_distance",
-        r.refinement_max_correspondence_distance);
-  visit("registration", "refinement_max_iterations", r.refinement_max_iterations);
-  visit("registration", "refinement_transformation_epsilon",
-        r.refinement_transformation_epsilon);
-  visit("registration", "refinement_stride", r.refinement_stride);
-  visit("pipeline", "use_segmentation", o.use_segmentation);
-  visit("pipeline", "static_consensus", o.static_consensus);
-  visit("pipeline", "inlier_noise_factor", o.inlier_noise_factor);
-  visit("pipeline", "min_inlier_threshold", o.min_inlier_threshold);
-  visit("pipeline", "threads", o.threads);
+  for (auto& field : fields)
+    field.name = prefix + "." + field.name;
+  return fields;
 }
 
-const char* const REFINEMENTS[] = {"none", "icp", "gicp"};
-
-cv::FileNode
-sectionNode(const cv::FileStorage& fs, const std::string& section)
+/// The path of a key: "scene_flow.depth.min_depth" -> {"scene_flow", "depth", "min_depth"}.
+std::vector<std::string>
+splitKey(const std::string& key)
 {
-  const auto dot = section.find('.');
-  if (dot == std::string::npos)
-    return fs[section];
-  return fs[section.substr(0, dot)][section.substr(dot + 1)];
+  std::vector<std::string> parts;
+  std::istringstream in(key);
+  for (std::string part; std::getline(in, part, '.');)
+    parts.push_back(part);
+  return parts;
+}
+
+/// Opens a YAML file; \throws pcl::IOException "path: failure" or "path: error (OpenCV's)"
+void
+openStorage(cv::FileStorage& fs,
+            const std::string& path,
+            int mode,
+            const std::string& failure,
+            const std::string& error)
+{
+  try {
+    fs.open(path, mode | cv::FileStorage::FORMAT_YAML);
+  }
+  catch (const cv::Exception& e) {
+    throw pcl::IOException(path + ": " + error + " (" + e.err + ")");
+  }
+  if (!fs.isOpened())
+    throw pcl::IOException(path + ": " + failure);
 }
 
 } // namespace
+
+const ParameterTable<PipelineOptions>&
+PipelineOptions::table()
+{
+  using P = PipelineOptions;
+  using R = FieldRange;
+  static const ParameterTable<P> table(std::vector<ParameterTable<P>::Field>{
+      makeField("use_segmentation", &P::use_segmentation, R::any(),
+                "0 = ablation: every valid flow cell is static"),
+      makeField("static_consensus", &P::static_consensus, R::atLeast(0),
+                "x inlier threshold, 0 = off"),
+      makeField("inlier_noise_factor", &P::inlier_noise_factor, R::atLeast(0),
+                "x mean static residual, 0 = off"),
+      makeField("min_inlier_threshold", &P::min_inlier_threshold, R::above(0),
+                "m^2, <= segmentation.inlier_threshold"),
+      makeField("threads", &P::threads, R::atLeast(1), "worker threads"),
+  });
+  return table;
+}
+
+const ParameterTable<PipelineOptions>&
+pipelineConfigTable()
+{
+  using P = PipelineOptions;
+  static const ParameterTable<P> table{
+      nestFields("scene_flow", &P::scene_flow,
+                 GridSceneFlowParameters::table().fields()),
+      nestFields("segmentation", &P::segmentation,
+                 RigidMotionSegmentationParameters::table().fields()),
+      nestFields("registration", &P::registration,
+                 StaticSceneRegistrationParameters::table().fields()),
+      prefixFields("pipeline", P::table().fields())};
+  return table;
+}
+
+std::string
+pipelineConfigHelp(const PipelineOptions& options)
+{
+  std::ostringstream out;
+  for (const auto& field : pipelineConfigTable().fields()) {
+    const std::string head = "  " + field.name + " " + field.text(options);
+    out << head << std::string(head.size() < 52 ? 52 - head.size() : 1, ' ') << "("
+        << field.doc << "; ";
+    if (field.kind == FieldKind::choice) {
+      for (std::size_t k = 0; k < field.choices.size(); ++k)
+        out << (k ? "|" : "") << field.choices[k];
+    }
+    else
+      out << (field.kind == FieldKind::boolean ? "0 or 1" : field.range.describe());
+    out << ")\n";
+  }
+  return out.str();
+}
 
 void
 loadPipelineConfig(const std::string& path, PipelineOptions& options)
 {
   cv::FileStorage fs;
-  try {
-    fs.open(path, cv::FileStorage::READ | cv::FileStorage::FORMAT_YAML);
-  }
-  catch (const cv::Exception& e) {
-    throw pcl::IOException(path + ": not a readable YAML file (" + e.err + ")");
-  }
-  if (!fs.isOpened())
-    throw pcl::IOException(path + ": cannot open configuration file");
+  openStorage(fs, path, cv::FileStorage::READ, "cannot open configuration file",
+              "not a readable YAML file");
 
-  std::set<std::string> known;
   const auto fail = [&](const std::string& key, const std::string& problem) {
     throw pcl::IOException(path + ": " + key + ": " + problem);
   };
-  visitFields(options, [&](const std::string& section, const std::string& name,
-                           auto& field) {
-    using Field = std::decay_t<decltype(field)>;
-    const std::string key = section + "." + name;
-    known.insert(key);
-    known.insert(section);
-    if (section.find('.') != std::string::npos)
-      known.insert(section.substr(0, section.find('.')));
-    const cv::FileNode node = sectionNode(fs, section)[name];
+  std::set<std::string> known; // every key and every map on the way to one
+  for (const auto& field : pipelineConfigTable().fields()) {
+    const std::vector<std::string> parts = splitKey(field.name);
+    cv::FileNode node = fs[parts[0]];
+    std::string prefix = parts[0];
+    known.insert(prefix);
+    for (std::size_t k = 1; k < parts.size(); ++k) {
+      node = node.empty() ? node : node[parts[k]];
+      prefix += "." + parts[k];
+      known.insert(prefix);
+    }
     if (node.empty())
-      return;
-    if constexpr (std::is_same_v<Field, RegistrationRefinement>) {
+      continue;
+    double value = 0.0;
+    switch (field.kind) {
+    case FieldKind::choice: {
+      std::string expected = "expected one of ";
+      for (std::size_t k = 0; k < field.choices.size(); ++k)
+        expected += (k ? ", " : "") + field.choices[k];
       if (!node.isString())
-        fail(key, "expected one of none, icp, gicp");
-      const std::string value = node.string();
-      for (int k = 0; k < 3; ++k)
-        if (value == REFINEMENTS[k]) {
-          field = static_cast<RegistrationRefinement>(k);
-          return;
-        }
-      fail(key, "expected one of none, icp, gicp, got '" + value + "'");
+        fail(field.name, expected);
+      const std::string text = node.string();
+      value = field.choiceIndex(text);
+      if (value < 0)
+        fail(field.name, expected + ", got '" + text + "'");
+      break;
     }
-    else if constexpr (std::is_same_v<Field, bool>) {
+    case FieldKind::boolean:
       if (!node.isInt() || (static_cast<int>(node) != 0 && static_cast<int>(node) != 1))
-        fail(key, "expected 0 or 1");
-      field = static_cast<int>(node) == 1;
-    }
-    else if constexpr (std::is_integral_v<Field>) {
-      if (!node.isInt() || (std::is_unsigned_v<Field> && static_cast<int>(node) < 0))
-        fail(key, std::is_unsigned_v<Field> ? "expected a non-negative integer"
-                                            : "expected an integer");
-      field = static_cast<Field>(static_cast<int>(node));
-    }
-    else {
+        fail(field.name, "expected 0 or 1");
+      value = static_cast<int>(node);
+      break;
+    case FieldKind::integer:
+      // A whole number beyond int (a seed from 2^31) is written as a real.
+      if (!node.isInt() && !node.isReal())
+        fail(field.name, "expected an integer");
+      value = node.isInt() ? static_cast<int>(node) : static_cast<double>(node);
+      break;
+    case FieldKind::real:
       if (!node.isReal() && !node.isInt())
-        fail(key, "expected a number");
-      field = static_cast<Field>(static_cast<double>(node));
+        fail(field.name, "expected a number");
+      value = static_cast<double>(node);
+      break;
     }
-  });
+    const std::string problem = field.problem(value);
+    if (!problem.empty())
+      fail(field.name, problem);
+    field.set(options, value);
+  }
 
   // Every key of the file must be known: a typo must not be ignored silently.
   const std::function<void(const cv::FileNode&, const std::string&)> check =
@@ -176,45 +194,42 @@ void
 writePipelineConfig(const std::string& path, const PipelineOptions& options)
 {
   cv::FileStorage fs;
-  try {
-    fs.open(path, cv::FileStorage::WRITE | cv::FileStorage::FORMAT_YAML);
-  }
-  catch (const cv::Exception& e) {
-    throw pcl::IOException(path + ": cannot write configuration file (" + e.err + ")");
-  }
-  if (!fs.isOpened())
-    throw pcl::IOException(path + ": cannot write configuration file");
-  PipelineOptions copy = options;
-  std::string open_section;
-  visitFields(copy, [&](const std::string& section, const std::string& name,
-                        auto& field) {
-    using Field = std::decay_t<decltype(field)>;
-    if (section != open_section) {
-      // Close the previous map(s) and open the new one(s); "a.b" nests b inside a.
-      const auto depth = [](const std::string& s) {
-        return s.empty() ? 0
-                         : 1 + static_cast<int>(std::count(s.begin(), s.end(), '.'));
-      };
-      const std::string parent = section.substr(0, section.find('.'));
-      const bool stays_in_parent = open_section.rfind(parent, 0) == 0;
-      for (int d = depth(open_section); d > (stays_in_parent ? 1 : 0); --d)
-        fs << "}";
-      if (!stays_in_parent)
-        fs << parent << "{";
-      if (section.find('.') != std::string::npos)
-        fs << section.substr(section.find('.') + 1) << "{";
-      open_section = section;
+  openStorage(fs, path, cv::FileStorage::WRITE, "cannot write configuration file",
+              "cannot write configuration file");
+  std::vector<std::string> open_maps; // the maps around the last key, outermost first
+  for (const auto& field : pipelineConfigTable().fields()) {
+    std::vector<std::string> parts = splitKey(field.name);
+    const std::string name = parts.back();
+    parts.pop_back();
+    // Close the maps this key is not in, then open the ones it is in.
+    std::size_t shared = 0;
+    while (shared < open_maps.size() && shared < parts.size() &&
+           open_maps[shared] == parts[shared])
+      ++shared;
+    for (std::size_t k = open_maps.size(); k > shared; --k)
+      fs << "}";
+    for (std::size_t k = shared; k < parts.size(); ++k)
+      fs << parts[k] << "{";
+    open_maps = parts;
+    const double value = field.get(options);
+    switch (field.kind) {
+    case FieldKind::choice:
+      fs << name << field.text(options);
+      break;
+    case FieldKind::boolean:
+    case FieldKind::integer:
+      if (value >= std::numeric_limits<int>::min() &&
+          value <= std::numeric_limits<int>::max()) {
+        fs << name << static_cast<int>(value);
+        break;
+      }
+      [[fallthrough]];
+    case FieldKind::real:
+      fs << name << value;
+      break;
     }
-    if constexpr (std::is_same_v<Field, RegistrationRefinement>)
-      fs << name << std::string(REFINEMENTS[static_cast<int>(field)]);
-    else if constexpr (std::is_same_v<Field, bool> || std::is_integral_v<Field>)
-      fs << name << static_cast<int>(field);
-    else
-      fs << name << static_cast<double>(field);
-  });
-  for (int d = 1 + static_cast<int>(
-                       std::count(open_section.begin(), open_section.end(), '.'));
-       d > 0; --d)
+  }
+  for (std::size_t k = open_maps.size(); k > 0; --k)
     fs << "}";
   fs.release();
 }

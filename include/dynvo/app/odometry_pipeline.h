@@ -4,6 +4,7 @@
 
 #include <dynvo/common/camera.h>
 #include <dynvo/common/export.h>
+#include <dynvo/common/parameter_table.h>
 #include <dynvo/motion_segmentation/rigid_motion_segmentation_parameters.h>
 #include <dynvo/registration/static_scene_registration_parameters.h>
 #include <dynvo/scene_flow/grid_scene_flow_parameters.h>
@@ -63,6 +64,10 @@ struct DYNVO_EXPORTS PipelineOptions {
   float min_inlier_threshold =
       3e-5f;            ///< lower bound of the noise-following threshold (m^2)
   unsigned threads = 1; ///< worker threads; results do not depend on it
+
+  /// Names, units and ranges of the pipeline's own fields above (use_segmentation ...
+  /// threads), in file order; the modules' fields are in their Parameters::table().
+  static const ParameterTable<PipelineOptions>& table();
 
   /// \throws std::invalid_argument when a module's parameters or a pipeline value are invalid
   void validate() const;

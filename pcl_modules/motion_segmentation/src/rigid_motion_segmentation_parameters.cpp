@@ -1,72 +1,71 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Range checks of RigidMotionSegmentationParameters.
+// The field table and the checks of RigidMotionSegmentationParameters.
 #include <dynvo/motion_segmentation/rigid_motion_segmentation_parameters.h>
 
-#include <cmath>
 #include <stdexcept>
 #include <string>
 
 namespace dynvo {
 
+const ParameterTable<RigidMotionSegmentationParameters>&
+RigidMotionSegmentationParameters::table()
+{
+  using P = RigidMotionSegmentationParameters;
+  using R = FieldRange;
+  static_assert(AGGREGATE_FIELD_COUNT<P> == 24, "every field of P needs a row below");
+  static const ParameterTable<P> table(std::vector<ParameterTable<P>::Field>{
+      makeField("cell_size", &P::cell_size, R::atLeast(2),
+                "w_grid, px, = scene flow's"),
+      makeField("max_hypotheses", &P::max_hypotheses, R::closed(1, 254), "h_max"),
+      makeField("max_trials", &P::max_trials, R::atLeast(1),
+                "T_max, >= max_hypotheses"),
+      makeField("sample_size", &P::sample_size, R::atLeast(3), "m, points"),
+      makeField("search_radius", &P::search_radius, R::atLeast(1), "r_search, cells"),
+      makeField("inlier_threshold", &P::inlier_threshold, R::above(0),
+                "th_inlier, m^2"),
+      makeField("entropy_lambda", &P::entropy_lambda, R::above(0), "lambda, m^-2"),
+      makeField("entropy_delta", &P::entropy_delta, R::above(0), "delta"),
+      makeField("refine_iterations", &P::refine_iterations, R::atLeast(1),
+                "refine_iters"),
+      makeField("entropy_done", &P::entropy_done, R::closed(0, 1), "s_done"),
+      makeField("entropy_saturation", &P::entropy_saturation, R::atLeast(0), "s_sat"),
+      makeField("dbscan_min_points", &P::dbscan_min_points, R::atLeast(1), "p_min"),
+      makeField("dbscan_epsilon", &P::dbscan_epsilon, R::above(0), "eps, metres"),
+      makeField("min_segment_size", &P::min_segment_size, R::atLeast(1),
+                "n_seg_min, cells"),
+      makeField("tracking", &P::tracking, R::any(), "0 = two-frame segments"),
+      makeField("max_labels", &P::max_labels, R::closed(2, 254), "n_obj"),
+      makeField("max_age", &P::max_age, R::atLeast(1), "alpha_max, frames"),
+      makeField("buffer_length", &P::buffer_length, R::atLeast(1), "L_buf, frames"),
+      makeField("min_correlation", &P::min_correlation, R{0, 1, true, false}, "c_min"),
+      makeField("static_guard_tolerance", &P::static_guard_tolerance, R::above(0),
+                "tau_cv, metres"),
+      makeField("static_min_cells", &P::static_min_cells, R::atLeast(1),
+                "n_static_min, cells"),
+      makeField("object_separation_ratio", &P::object_separation_ratio, R::atLeast(0),
+                "k_sep, 0 = off"),
+      makeField("object_separation_hold", &P::object_separation_hold, R::atLeast(1),
+                "k_hold, <= k_sep"),
+      makeField("seed", &P::seed, R::closed(0, 4294967295.0), "sampling seed"),
+  });
+  return table;
+}
+
 void
 RigidMotionSegmentationParameters::validate() const
 {
-  const auto fail = [](const std::string& what) {
-    throw std::invalid_argument(
-        "[dynvo::RigidMotionSegmentationParameters::validate] " + what);
-  };
-  const auto positive = [](float x) {
-    return std::isfinite(x) && x > 0.0f;
-  };
-  if (cell_size < 2)
-    fail("cell_size must be >= 2 px, got " + std::to_string(cell_size));
-  if (max_hypotheses < 1 || max_hypotheses > 254)
-    fail("max_hypotheses must be in [1, 254], got " + std::to_string(max_hypotheses));
+  const std::string prefix = "[dynvo::RigidMotionSegmentationParameters::validate]";
+  table().checkAll(*this, prefix);
   if (max_trials < max_hypotheses)
-    fail("max_trials must be >= max_hypotheses, got " + std::to_string(max_trials));
-  if (sample_size < 3)
-    fail("sample_size must be >= 3 points, got " + std::to_string(sample_size));
-  if (search_radius < 1)
-    fail("search_radius must be >= 1 cell, got " + std::to_string(search_radius));
-  if (!positive(inlier_threshold))
-    fail("inlier_threshold must be > 0 m^2, got " + std::to_string(inlier_threshold));
-  if (!positive(entropy_lambda))
-    fail("entropy_lambda must be > 0 m^-2, got " + std::to_string(entropy_lambda));
-  if (!positive(entropy_delta))
-    fail("entropy_delta must be > 0, got " + std::to_string(entropy_delta));
-  if (refine_iterations < 1)
-    fail("refine_iterations must be >= 1, got " + std::to_string(refine_iterations));
-  if (!(entropy_done >= 0.0f && entropy_done <= 1.0f))
-    fail("entropy_done must be in [0, 1], got " + std::to_string(entropy_done));
-  if (!(std::isfinite(entropy_saturation) && entropy_saturation >= 0.0f))
-    fail("entropy_saturation must be >= 0, got " + std::to_string(entropy_saturation));
-  if (dbscan_min_points < 1)
-    fail("dbscan_min_points must be >= 1, got " + std::to_string(dbscan_min_points));
-  if (!positive(dbscan_epsilon))
-    fail("dbscan_epsilon must be > 0 m, got " + std::to_string(dbscan_epsilon));
-  if (min_segment_size < 1)
-    fail("min_segment_size must be >= 1 cell, got " + std::to_string(min_segment_size));
-  if (max_labels < 2 || max_labels > 254)
-    fail("max_labels must be in [2, 254], got " + std::to_string(max_labels));
-  if (!(std::isfinite(max_age) && max_age >= 1.0f))
-    fail("max_age must be >= 1 frame, got " + std::to_string(max_age));
-  if (buffer_length < 1)
-    fail("buffer_length must be >= 1 frame, got " + std::to_string(buffer_length));
-  if (!(min_correlation > 0.0f && min_correlation <= 1.0f))
-    fail("min_correlation must be in (0, 1], got " + std::to_string(min_correlation));
-  if (!positive(static_guard_tolerance))
-    fail("static_guard_tolerance must be > 0 m, got " +
-         std::to_string(static_guard_tolerance));
-  if (static_min_cells < 1)
-    fail("static_min_cells must be >= 1 cell, got " + std::to_string(static_min_cells));
-  if (!(std::isfinite(object_separation_ratio) && object_separation_ratio >= 0.0f))
-    fail("object_separation_ratio must be >= 0, got " +
-         std::to_string(object_separation_ratio));
-  if (!(object_separation_hold >= 1.0f &&
-        (object_separation_ratio == 0.0f ||
-         object_separation_hold <= object_separation_ratio)))
-    fail("object_separation_hold must be in [1, object_separation_ratio], got " +
-         std::to_string(object_separation_hold));
+    throw std::invalid_argument(prefix + " max_trials must be >= max_hypotheses (" +
+                                std::to_string(max_hypotheses) + "), got " +
+                                std::to_string(max_trials));
+  if (object_separation_ratio != 0.0f &&
+      object_separation_hold > object_separation_ratio)
+    throw std::invalid_argument(
+        prefix + " object_separation_hold must be <= object_separation_ratio (" +
+        formatFieldValue(object_separation_ratio, true) + "), got " +
+        formatFieldValue(object_separation_hold, true));
 }
 
 } // namespace dynvo

@@ -192,14 +192,12 @@ TEST(RigidMotionSegmentationContract, BadParametersThrow)
   EXPECT_THROW(segmentation.setInlierThreshold(0.0f), std::invalid_argument);
   EXPECT_THROW(segmentation.setSampleSize(2), std::invalid_argument);
   EXPECT_THROW(segmentation.setMaxHypotheses(0), std::invalid_argument);
-  EXPECT_THROW(segmentation.setMaxTrials(5), std::invalid_argument); // < max_hypotheses
+  EXPECT_THROW(segmentation.setMaxTrials(0), std::invalid_argument);
   EXPECT_THROW(segmentation.setDbscanEpsilon(-1.0f), std::invalid_argument);
   EXPECT_THROW(segmentation.setMaxLabels(255), std::invalid_argument);
   EXPECT_THROW(segmentation.setMinCorrelation(0.0f), std::invalid_argument);
   EXPECT_THROW(segmentation.setObjectSeparationRatio(-1.0f), std::invalid_argument);
   EXPECT_THROW(segmentation.setObjectSeparationHold(0.5f), std::invalid_argument);
-  EXPECT_THROW(segmentation.setObjectSeparationHold(4.0f),
-               std::invalid_argument); // > 3
   EXPECT_THROW(segmentation.setNumberOfThreads(0), std::invalid_argument);
   dynvo::CameraIntrinsics bad;
   bad.fx = 0.0;
@@ -211,6 +209,30 @@ TEST(RigidMotionSegmentationContract, BadParametersThrow)
   EXPECT_EQ(segmentation.getCellSize(), 16);
   EXPECT_FLOAT_EQ(segmentation.getInlierThreshold(),
                   dynvo::RigidMotionSegmentationParameters{}.inlier_threshold);
+}
+
+TEST(RigidMotionSegmentationContract, CrossFieldRulesAreCheckedBySegmentNotBySetters)
+{
+  // 250 hypotheses need max_trials >= 250; with max_trials still at its default 200, the
+  // setter must accept the value, so that the two setters work in either order.
+  dynvo::RigidMotionSegmentation<pcl::PointXYZRGB> segmentation;
+  EXPECT_NO_THROW(segmentation.setMaxHypotheses(250));
+  std::vector<pcl::PointIndices> segments(2);
+  try {
+    segmentation.segment(segments);
+    ADD_FAILURE() << "segment() accepted max_trials < max_hypotheses";
+  }
+  catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("max_trials"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(segments.empty());
+  EXPECT_NO_THROW(segmentation.setMaxTrials(300));
+  EXPECT_NO_THROW(segmentation.getParameters().validate());
+  // Likewise object_separation_hold <= object_separation_ratio (3 by default).
+  EXPECT_NO_THROW(segmentation.setObjectSeparationHold(4.0f));
+  EXPECT_THROW(segmentation.segment(segments), std::invalid_argument);
+  EXPECT_NO_THROW(segmentation.setObjectSeparationRatio(5.0f));
+  EXPECT_NO_THROW(segmentation.getParameters().validate());
 }
 
 } // namespace

@@ -1,46 +1,37 @@
 // SPDX-License-Identifier: BSD-3-Clause
+// The field table and the checks of StaticSceneRegistrationParameters.
 #include <dynvo/registration/static_scene_registration_parameters.h>
 
-#include <cmath>
-#include <stdexcept>
-#include <string>
-
 namespace dynvo {
+
+const ParameterTable<StaticSceneRegistrationParameters>&
+StaticSceneRegistrationParameters::table()
+{
+  using P = StaticSceneRegistrationParameters;
+  using R = FieldRange;
+  static_assert(AGGREGATE_FIELD_COUNT<P> == 9, "every field of P needs a row below");
+  static const ParameterTable<P> table(std::vector<ParameterTable<P>::Field>{
+      makeField("th_inlier", &P::th_inlier, R::above(0), "th_inlier, m^2"),
+      makeField("trim_factor", &P::trim_factor, R::atLeast(1), "trim"),
+      makeField("trim_rounds", &P::trim_rounds, R::atLeast(0), "trim rounds"),
+      makeField("min_correspondences", &P::min_correspondences, R::atLeast(3), "cells"),
+      makeChoiceField("refinement", &P::refinement, {"none", "icp", "gicp"},
+                      "ICP/GICP after the flow estimate"),
+      makeField("refinement_max_correspondence_distance",
+                &P::refinement_max_correspondence_distance, R::above(0), "metres"),
+      makeField("refinement_max_iterations", &P::refinement_max_iterations,
+                R::atLeast(1), "ICP/GICP iterations"),
+      makeField("refinement_transformation_epsilon",
+                &P::refinement_transformation_epsilon, R::atLeast(0), "m^2"),
+      makeField("refinement_stride", &P::refinement_stride, R::atLeast(1), "px"),
+  });
+  return table;
+}
 
 void
 StaticSceneRegistrationParameters::validate() const
 {
-  const auto fail = [](const std::string& what) {
-    throw std::invalid_argument(
-        "[dynvo::StaticSceneRegistration::Parameters::validate] " + what);
-  };
-  if (!(std::isfinite(th_inlier) && th_inlier > 0.0f))
-    fail("th_inlier must be finite and > 0 m^2, got " + std::to_string(th_inlier));
-  if (!(std::isfinite(trim_factor) && trim_factor >= 1.0f))
-    fail("trim_factor must be finite and >= 1, got " + std::to_string(trim_factor));
-  if (trim_rounds < 0)
-    fail("trim_rounds must be >= 0, got " + std::to_string(trim_rounds));
-  if (min_correspondences < 3)
-    fail("min_correspondences must be >= 3 (a rigid fit needs 3 points), got " +
-         std::to_string(min_correspondences));
-  if (refinement != RegistrationRefinement::none &&
-      refinement != RegistrationRefinement::icp &&
-      refinement != RegistrationRefinement::gicp)
-    fail("refinement must be none, icp or gicp, got " +
-         std::to_string(static_cast<int>(refinement)));
-  if (!(std::isfinite(refinement_max_correspondence_distance) &&
-        refinement_max_correspondence_distance > 0.0))
-    fail("refinement_max_correspondence_distance must be finite and > 0 m, got " +
-         std::to_string(refinement_max_correspondence_distance));
-  if (refinement_max_iterations < 1)
-    fail("refinement_max_iterations must be >= 1, got " +
-         std::to_string(refinement_max_iterations));
-  if (!(std::isfinite(refinement_transformation_epsilon) &&
-        refinement_transformation_epsilon >= 0.0))
-    fail("refinement_transformation_epsilon must be finite and >= 0 m^2, got " +
-         std::to_string(refinement_transformation_epsilon));
-  if (refinement_stride < 1)
-    fail("refinement_stride must be >= 1 px, got " + std::to_string(refinement_stride));
+  table().checkAll(*this, "[dynvo::StaticSceneRegistration::Parameters::validate]");
 }
 
 } // namespace dynvo

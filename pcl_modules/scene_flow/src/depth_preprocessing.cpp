@@ -36,25 +36,35 @@ similar(float zl, float zr, float tolerance)
 
 } // namespace
 
+const ParameterTable<DepthPreprocessing::Parameters>&
+DepthPreprocessing::Parameters::table()
+{
+  using P = Parameters;
+  static_assert(AGGREGATE_FIELD_COUNT<P> == 5, "every field of P needs a row below");
+  static const ParameterTable<P> table(std::vector<ParameterTable<P>::Field>{
+      makeField("min_depth", &P::min_depth, FieldRange::above(0), "z_min, metres"),
+      makeField("max_depth", &P::max_depth, FieldRange::above(0),
+                "z_max, metres, > min_depth"),
+      makeField("flying_pixel_tolerance", &P::flying_pixel_tolerance,
+                FieldRange{0, 1, true, true}, "tau_fly, relative"),
+      makeField("max_hole_width", &P::max_hole_width, FieldRange::atLeast(0),
+                "w_hole, px, 0 = no filling"),
+      makeField("hole_fill_tolerance", &P::hole_fill_tolerance, FieldRange::atLeast(0),
+                "tau_fill, relative"),
+  });
+  return table;
+}
+
 void
 DepthPreprocessing::Parameters::validate() const
 {
-  const auto fail = [](const std::string& what) {
-    throw std::invalid_argument("[dynvo::DepthPreprocessing::Parameters::validate] " +
-                                what);
-  };
-  if (!(std::isfinite(min_depth) && std::isfinite(max_depth) && min_depth > 0.0f &&
-        max_depth > min_depth))
-    fail("need 0 < min_depth < max_depth (metres), got min_depth=" +
-         std::to_string(min_depth) + " max_depth=" + std::to_string(max_depth));
-  if (!(flying_pixel_tolerance > 0.0f && flying_pixel_tolerance < 1.0f))
-    fail("flying_pixel_tolerance must be in (0, 1), got " +
-         std::to_string(flying_pixel_tolerance));
-  if (max_hole_width < 0)
-    fail("max_hole_width must be >= 0 px, got " + std::to_string(max_hole_width));
-  if (!(hole_fill_tolerance >= 0.0f && std::isfinite(hole_fill_tolerance)))
-    fail("hole_fill_tolerance must be finite and >= 0, got " +
-         std::to_string(hole_fill_tolerance));
+  const std::string prefix = "[dynvo::DepthPreprocessing::Parameters::validate]";
+  table().checkAll(*this, prefix);
+  if (!(max_depth > min_depth))
+    throw std::invalid_argument(prefix +
+                                " max_depth must be > min_depth, got min_depth " +
+                                formatFieldValue(min_depth, true) + ", max_depth " +
+                                formatFieldValue(max_depth, true));
 }
 
 DepthPreprocessing::DepthPreprocessing(const Parameters& parameters)

@@ -15,45 +15,6 @@
 
 namespace dynvo {
 
-void
-GridSceneFlowParameters::validate() const
-{
-  const auto fail = [](const std::string& what) {
-    throw std::invalid_argument("[dynvo::GridSceneFlowParameters::validate] " + what);
-  };
-  if (cell_size < 2)
-    fail("cell_size must be >= 2 px, got " + std::to_string(cell_size));
-  depth.validate();
-  if (window_size < 3)
-    fail("window_size must be >= 3 px, got " + std::to_string(window_size));
-  if (max_pyramid_level < 0)
-    fail("max_pyramid_level must be >= 0, got " + std::to_string(max_pyramid_level));
-  if (max_iterations < 1)
-    fail("max_iterations must be >= 1, got " + std::to_string(max_iterations));
-  if (!(epsilon > 0.0 && std::isfinite(epsilon)))
-    fail("epsilon must be > 0 px, got " + std::to_string(epsilon));
-  if (!(min_eigen_threshold > 0.0 && std::isfinite(min_eigen_threshold)))
-    fail("min_eigen_threshold must be > 0, got " + std::to_string(min_eigen_threshold));
-  if (forward_backward_check != ForwardBackwardCheck::full &&
-      forward_backward_check != ForwardBackwardCheck::local)
-    fail("forward_backward_check must be full or local, got " +
-         std::to_string(static_cast<int>(forward_backward_check)));
-  if (!(forward_backward_threshold > 0.0f && std::isfinite(forward_backward_threshold)))
-    fail("forward_backward_threshold must be > 0 px, got " +
-         std::to_string(forward_backward_threshold));
-  if (!(depth_edge_tolerance >= 0.0f && std::isfinite(depth_edge_tolerance)))
-    fail("depth_edge_tolerance must be finite and >= 0, got " +
-         std::to_string(depth_edge_tolerance));
-  if (depth_window_radius < 0 || depth_window_radius > 15)
-    fail("depth_window_radius must be in [0, 15] px, got " +
-         std::to_string(depth_window_radius));
-  if (!(max_flow > 0.0f && std::isfinite(max_flow)))
-    fail("max_flow must be > 0 m, got " + std::to_string(max_flow));
-  if (!(weight_reference_depth > 0.0f && std::isfinite(weight_reference_depth)))
-    fail("weight_reference_depth must be > 0 m, got " +
-         std::to_string(weight_reference_depth));
-}
-
 namespace detail {
 
 namespace {

@@ -437,7 +437,7 @@ TEST_F(GridSceneFlowContractTest, BadParametersThrowAndKeepTheOldValue)
   EXPECT_THROW(estimation_.setDepthEdgeTolerance(-0.1f), std::invalid_argument);
   EXPECT_THROW(estimation_.setMaxFlow(0.0f), std::invalid_argument);
   EXPECT_THROW(estimation_.setWeightReferenceDepth(0.0f), std::invalid_argument);
-  EXPECT_THROW(estimation_.setMinDepth(6.0f), std::invalid_argument); // above z_max
+  EXPECT_THROW(estimation_.setMinDepth(-1.0f), std::invalid_argument);
   EXPECT_EQ(estimation_.getMinDepth(), 0.3f);
   EXPECT_THROW(estimation_.setMaxHoleWidth(-2), std::invalid_argument);
   EXPECT_THROW(estimation_.setFlyingPixelTolerance(0.0f), std::invalid_argument);
@@ -449,6 +449,19 @@ TEST_F(GridSceneFlowContractTest, BadParametersThrowAndKeepTheOldValue)
   parameters.max_flow = -1.0f;
   EXPECT_THROW(estimation_.setParameters(parameters), std::invalid_argument);
   EXPECT_EQ(estimation_.getMaxFlow(), dynvo::GridSceneFlowParameters{}.max_flow);
+}
+
+TEST_F(GridSceneFlowContractTest,
+       DepthRangeIsCheckedWhenComputingSoSettersWorkInAnyOrder)
+{
+  // Moving the range to [6, 8] m raises min_depth first: above the old max_depth, which a
+  // setter must not reject, since its own range (> 0) is met.
+  EXPECT_NO_THROW(estimation_.setMinDepth(6.0f));
+  flow_.resize(3);
+  EXPECT_THROW(estimation_.compute(flow_), std::invalid_argument);
+  EXPECT_TRUE(flow_.empty());
+  EXPECT_NO_THROW(estimation_.setMaxDepth(8.0f));
+  EXPECT_NO_THROW(estimation_.getParameters().validate());
 }
 
 } // namespace

@@ -84,6 +84,8 @@ public:
    * \param[out] segments element 0 = static background, then moving objects by id (see
    *             the class doc); empty when the inputs break the contract (null,
    *             unorganized, flow grid not matching the cloud), which is logged with PCL_ERROR
+   * \throws std::invalid_argument (outputs left empty) when getParameters().validate()
+   *         fails, e.g. max_trials < max_hypotheses after the per-field setters
    */
   void segment(std::vector<pcl::PointIndices>& segments);
 
@@ -133,86 +135,35 @@ public:
 
   const Parameters& getParameters() const { return params_; }
 
-  // One setter/getter pair per field of Parameters; each throws std::invalid_argument on a
-  // value out of the range documented in RigidMotionSegmentationParameters.
-  void setCellSize(int px) { updateField(&Parameters::cell_size, px); }
-  int getCellSize() const { return params_.cell_size; }
-  void setMaxHypotheses(int count) { updateField(&Parameters::max_hypotheses, count); }
-  int getMaxHypotheses() const { return params_.max_hypotheses; }
-  void setMaxTrials(int count) { updateField(&Parameters::max_trials, count); }
-  int getMaxTrials() const { return params_.max_trials; }
-  void setSampleSize(int points) { updateField(&Parameters::sample_size, points); }
-  int getSampleSize() const { return params_.sample_size; }
-  void setSearchRadius(int cells) { updateField(&Parameters::search_radius, cells); }
-  int getSearchRadius() const { return params_.search_radius; }
-  void setInlierThreshold(float m2) { updateField(&Parameters::inlier_threshold, m2); }
-  float getInlierThreshold() const { return params_.inlier_threshold; }
-  void setEntropyLambda(float per_m2)
-  {
-    updateField(&Parameters::entropy_lambda, per_m2);
-  }
-  float getEntropyLambda() const { return params_.entropy_lambda; }
-  void setEntropyDelta(float delta) { updateField(&Parameters::entropy_delta, delta); }
-  float getEntropyDelta() const { return params_.entropy_delta; }
-  void setRefineIterations(int rounds)
-  {
-    updateField(&Parameters::refine_iterations, rounds);
-  }
-  int getRefineIterations() const { return params_.refine_iterations; }
-  void setEntropyDone(float mean) { updateField(&Parameters::entropy_done, mean); }
-  float getEntropyDone() const { return params_.entropy_done; }
-  void setEntropySaturation(float drop)
-  {
-    updateField(&Parameters::entropy_saturation, drop);
-  }
-  float getEntropySaturation() const { return params_.entropy_saturation; }
-  void setDbscanMinPoints(int count)
-  {
-    updateField(&Parameters::dbscan_min_points, count);
-  }
-  int getDbscanMinPoints() const { return params_.dbscan_min_points; }
-  void setDbscanEpsilon(float metres)
-  {
-    updateField(&Parameters::dbscan_epsilon, metres);
-  }
-  float getDbscanEpsilon() const { return params_.dbscan_epsilon; }
-  void setMinSegmentSize(int cells)
-  {
-    updateField(&Parameters::min_segment_size, cells);
-  }
-  int getMinSegmentSize() const { return params_.min_segment_size; }
-  void setTracking(bool on) { updateField(&Parameters::tracking, on); }
-  bool getTracking() const { return params_.tracking; }
-  void setMaxLabels(int count) { updateField(&Parameters::max_labels, count); }
-  int getMaxLabels() const { return params_.max_labels; }
-  void setMaxAge(float frames) { updateField(&Parameters::max_age, frames); }
-  float getMaxAge() const { return params_.max_age; }
-  void setBufferLength(int frames) { updateField(&Parameters::buffer_length, frames); }
-  int getBufferLength() const { return params_.buffer_length; }
-  void setMinCorrelation(float c) { updateField(&Parameters::min_correlation, c); }
-  float getMinCorrelation() const { return params_.min_correlation; }
-  void setStaticGuardTolerance(float metres)
-  {
-    updateField(&Parameters::static_guard_tolerance, metres);
-  }
-  float getStaticGuardTolerance() const { return params_.static_guard_tolerance; }
-  void setStaticMinCells(int cells)
-  {
-    updateField(&Parameters::static_min_cells, cells);
-  }
-  int getStaticMinCells() const { return params_.static_min_cells; }
-  void setObjectSeparationRatio(float ratio)
-  {
-    updateField(&Parameters::object_separation_ratio, ratio);
-  }
-  float getObjectSeparationRatio() const { return params_.object_separation_ratio; }
-  void setObjectSeparationHold(float ratio)
-  {
-    updateField(&Parameters::object_separation_hold, ratio);
-  }
-  float getObjectSeparationHold() const { return params_.object_separation_hold; }
-  void setSeed(std::uint32_t seed) { updateField(&Parameters::seed, seed); }
-  std::uint32_t getSeed() const { return params_.seed; }
+  // One setter/getter pair per field of Parameters. A setter throws std::invalid_argument
+  // when the value is outside the field's own range (RigidMotionSegmentationParameters::
+  // table()) and keeps the old value; the rules tying two fields (max_trials >=
+  // max_hypotheses, object_separation_hold <= object_separation_ratio) are checked by
+  // segment(), so the setters may come in any order.
+  DYNVO_PARAMETER_ACCESSORS(CellSize, cell_size)
+  DYNVO_PARAMETER_ACCESSORS(MaxHypotheses, max_hypotheses)
+  DYNVO_PARAMETER_ACCESSORS(MaxTrials, max_trials)
+  DYNVO_PARAMETER_ACCESSORS(SampleSize, sample_size)
+  DYNVO_PARAMETER_ACCESSORS(SearchRadius, search_radius)
+  DYNVO_PARAMETER_ACCESSORS(InlierThreshold, inlier_threshold)
+  DYNVO_PARAMETER_ACCESSORS(EntropyLambda, entropy_lambda)
+  DYNVO_PARAMETER_ACCESSORS(EntropyDelta, entropy_delta)
+  DYNVO_PARAMETER_ACCESSORS(RefineIterations, refine_iterations)
+  DYNVO_PARAMETER_ACCESSORS(EntropyDone, entropy_done)
+  DYNVO_PARAMETER_ACCESSORS(EntropySaturation, entropy_saturation)
+  DYNVO_PARAMETER_ACCESSORS(DbscanMinPoints, dbscan_min_points)
+  DYNVO_PARAMETER_ACCESSORS(DbscanEpsilon, dbscan_epsilon)
+  DYNVO_PARAMETER_ACCESSORS(MinSegmentSize, min_segment_size)
+  DYNVO_PARAMETER_ACCESSORS(Tracking, tracking)
+  DYNVO_PARAMETER_ACCESSORS(MaxLabels, max_labels)
+  DYNVO_PARAMETER_ACCESSORS(MaxAge, max_age)
+  DYNVO_PARAMETER_ACCESSORS(BufferLength, buffer_length)
+  DYNVO_PARAMETER_ACCESSORS(MinCorrelation, min_correlation)
+  DYNVO_PARAMETER_ACCESSORS(StaticGuardTolerance, static_guard_tolerance)
+  DYNVO_PARAMETER_ACCESSORS(StaticMinCells, static_min_cells)
+  DYNVO_PARAMETER_ACCESSORS(ObjectSeparationRatio, object_separation_ratio)
+  DYNVO_PARAMETER_ACCESSORS(ObjectSeparationHold, object_separation_hold)
+  DYNVO_PARAMETER_ACCESSORS(Seed, seed)
 
 protected:
   using Base::deinitCompute;
@@ -228,12 +179,8 @@ protected:
   void computeImplIndices(std::vector<pcl::PointIndices>& segments) const;
 
 private:
-  template <typename Field> void updateField(Field Parameters::*field, Field value)
-  {
-    Parameters updated = params_;
-    updated.*field = value;
-    setParameters(updated);
-  }
+  /// Stores checked parameters (the sequence state is kept).
+  void assignParameters(const Parameters& parameters) { params_ = parameters; }
 
   /// Clears every output of segment().
   void clearOutputs();

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <dynvo/common/export.h>
+#include <dynvo/common/parameter_table.h>
 
 #include <cstdint>
 
@@ -75,7 +76,11 @@ struct DYNVO_EXPORTS RigidMotionSegmentationParameters {
   /// seed: hypothesis sampling RNG, re-seeded on every segment()
   std::uint32_t seed = 0;
 
-  /// \throws std::invalid_argument naming the first field out of the range stated above
+  /// Names, units and ranges of the fields above, in file order (ParameterTable).
+  static const ParameterTable<RigidMotionSegmentationParameters>& table();
+
+  /// \throws std::invalid_argument naming the first field out of the range stated above,
+  ///         including the rules that tie two fields (max_trials, object_separation_hold)
   void validate() const;
 };
 

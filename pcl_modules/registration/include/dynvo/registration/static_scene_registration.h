@@ -134,52 +134,25 @@ public:
   void setParameters(const Parameters& parameters)
   {
     parameters.validate();
-    params_ = parameters;
+    assignParameters(parameters);
   }
 
   const Parameters& getParameters() const { return params_; }
 
-  // One setter/getter pair per field of Parameters; each throws std::invalid_argument on a
-  // value out of the range documented in StaticSceneRegistrationParameters.
-  void setInlierThreshold(float m2) { updateField(&Parameters::th_inlier, m2); }
-  float getInlierThreshold() const { return params_.th_inlier; }
-  void setTrimFactor(float factor) { updateField(&Parameters::trim_factor, factor); }
-  float getTrimFactor() const { return params_.trim_factor; }
-  void setTrimRounds(int rounds) { updateField(&Parameters::trim_rounds, rounds); }
-  int getTrimRounds() const { return params_.trim_rounds; }
-  void setMinCorrespondences(int cells)
-  {
-    updateField(&Parameters::min_correspondences, cells);
-  }
-  int getMinCorrespondences() const { return params_.min_correspondences; }
-  void setRefinement(Refinement method)
-  {
-    updateField(&Parameters::refinement, method);
-  }
-  Refinement getRefinement() const { return params_.refinement; }
-  void setRefinementMaxCorrespondenceDistance(double metres)
-  {
-    updateField(&Parameters::refinement_max_correspondence_distance, metres);
-  }
-  double getRefinementMaxCorrespondenceDistance() const
-  {
-    return params_.refinement_max_correspondence_distance;
-  }
-  void setRefinementMaxIterations(int iterations)
-  {
-    updateField(&Parameters::refinement_max_iterations, iterations);
-  }
-  int getRefinementMaxIterations() const { return params_.refinement_max_iterations; }
-  void setRefinementTransformationEpsilon(double m2)
-  {
-    updateField(&Parameters::refinement_transformation_epsilon, m2);
-  }
-  double getRefinementTransformationEpsilon() const
-  {
-    return params_.refinement_transformation_epsilon;
-  }
-  void setRefinementStride(int px) { updateField(&Parameters::refinement_stride, px); }
-  int getRefinementStride() const { return params_.refinement_stride; }
+  // One setter/getter pair per field of Parameters. A setter throws std::invalid_argument
+  // when the value is outside the field's own range (StaticSceneRegistrationParameters::
+  // table()) and keeps the old value.
+  DYNVO_PARAMETER_ACCESSORS(InlierThreshold, th_inlier)
+  DYNVO_PARAMETER_ACCESSORS(TrimFactor, trim_factor)
+  DYNVO_PARAMETER_ACCESSORS(TrimRounds, trim_rounds)
+  DYNVO_PARAMETER_ACCESSORS(MinCorrespondences, min_correspondences)
+  DYNVO_PARAMETER_ACCESSORS(Refinement, refinement)
+  DYNVO_PARAMETER_ACCESSORS(RefinementMaxCorrespondenceDistance,
+                            refinement_max_correspondence_distance)
+  DYNVO_PARAMETER_ACCESSORS(RefinementMaxIterations, refinement_max_iterations)
+  DYNVO_PARAMETER_ACCESSORS(RefinementTransformationEpsilon,
+                            refinement_transformation_epsilon)
+  DYNVO_PARAMETER_ACCESSORS(RefinementStride, refinement_stride)
 
 protected:
   using Base::converged_;
@@ -208,12 +181,8 @@ protected:
   bool refine(Matrix4& refined) const;
 
 private:
-  template <typename Field> void updateField(Field Parameters::*field, Field value)
-  {
-    Parameters updated = params_;
-    updated.*field = value;
-    setParameters(updated);
-  }
+  /// Stores checked parameters.
+  void assignParameters(const Parameters& parameters) { params_ = parameters; }
 
   /// Clears every result; the final transformation becomes the guess.
   void resetResults(const Matrix4& guess);

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <dynvo/common/export.h>
+#include <dynvo/common/parameter_table.h>
 
 namespace dynvo {
 
@@ -36,6 +37,9 @@ struct DYNVO_EXPORTS StaticSceneRegistrationParameters {
       1e-8; ///< (m^2, >= 0): ICP/GICP stop when the squared translation step is smaller
   int refinement_stride =
       4; ///< (px, >= 1): ICP/GICP use every stride-th row and column of both frames (19,200 target points at VGA)
+
+  /// Names, units and ranges of the fields above, in file order (ParameterTable).
+  static const ParameterTable<StaticSceneRegistrationParameters>& table();
 
   /// \throws std::invalid_argument naming the first field out of the range stated above
   void validate() const;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <dynvo/common/export.h>
+#include <dynvo/common/parameter_table.h>
 
 #include <cstdint>
 #include <vector>
@@ -31,8 +32,8 @@ class DYNVO_EXPORTS DepthPreprocessing {
 public:
   /// Knobs of docs/algorithm.md §1.1 / §9.
   struct Parameters {
-    float min_depth = 0.3f; ///< z_min (metres): nearer depths are invalid
-    float max_depth = 5.0f; ///< z_max (metres): farther depths are invalid
+    float min_depth = 0.3f; ///< z_min (metres, > 0): nearer depths are invalid
+    float max_depth = 5.0f; ///< z_max (metres, > min_depth): farther depths are invalid
     /// tau_fly (relative, in (0, 1)): allowed deviation from the 3x3 median.
     float flying_pixel_tolerance = 0.05f;
     /// w_hole (px, >= 0; 0 disables filling): longest run of NaN that is filled.
@@ -40,7 +41,11 @@ public:
     /// tau_fill (relative, >= 0): largest |zL - zR| / min(zL, zR) that is filled.
     float hole_fill_tolerance = 0.05f;
 
-    /// \throws std::invalid_argument when a value is out of the range stated above
+    /// Names, units and ranges of the fields above, in file order (ParameterTable).
+    static const ParameterTable<Parameters>& table();
+
+    /// \throws std::invalid_argument when a value is out of the range stated above or
+    ///         max_depth <= min_depth
     void validate() const;
   };
 

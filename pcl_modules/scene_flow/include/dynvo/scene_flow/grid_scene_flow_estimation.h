@@ -81,6 +81,8 @@ public:
    * \param[out] flow organized grid (see the class doc); empty when the inputs break the
    *             contract (null, unorganized, sizes differ, smaller than one cell), which is
    *             logged with PCL_ERROR
+   * \throws std::invalid_argument (flow left empty) when getParameters().validate() fails,
+   *         e.g. min_depth >= max_depth after setMinDepth()/setMaxDepth()
    */
   void compute(FlowCloud& flow);
 
@@ -99,87 +101,26 @@ public:
 
   const Parameters& getParameters() const { return params_; }
 
-  // One setter/getter pair per field of Parameters; each throws std::invalid_argument on a
-  // value out of the range documented in GridSceneFlowParameters.
-  void setCellSize(int px) { updateField(&Parameters::cell_size, px); }
-  int getCellSize() const { return params_.cell_size; }
-  void setMinDepth(float metres)
-  {
-    updateDepthField(&DepthPreprocessing::Parameters::min_depth, metres);
-  }
-  float getMinDepth() const { return params_.depth.min_depth; }
-  void setMaxDepth(float metres)
-  {
-    updateDepthField(&DepthPreprocessing::Parameters::max_depth, metres);
-  }
-  float getMaxDepth() const { return params_.depth.max_depth; }
-  void setFlyingPixelTolerance(float ratio)
-  {
-    updateDepthField(&DepthPreprocessing::Parameters::flying_pixel_tolerance, ratio);
-  }
-  float getFlyingPixelTolerance() const { return params_.depth.flying_pixel_tolerance; }
-  void setMaxHoleWidth(int px)
-  {
-    updateDepthField(&DepthPreprocessing::Parameters::max_hole_width, px);
-  }
-  int getMaxHoleWidth() const { return params_.depth.max_hole_width; }
-  void setHoleFillTolerance(float ratio)
-  {
-    updateDepthField(&DepthPreprocessing::Parameters::hole_fill_tolerance, ratio);
-  }
-  float getHoleFillTolerance() const { return params_.depth.hole_fill_tolerance; }
-  void setWindowSize(int px) { updateField(&Parameters::window_size, px); }
-  int getWindowSize() const { return params_.window_size; }
-  void setMaxPyramidLevel(int level)
-  {
-    updateField(&Parameters::max_pyramid_level, level);
-  }
-  int getMaxPyramidLevel() const { return params_.max_pyramid_level; }
-  void setMaxIterations(int iterations)
-  {
-    updateField(&Parameters::max_iterations, iterations);
-  }
-  int getMaxIterations() const { return params_.max_iterations; }
-  void setEpsilon(double px) { updateField(&Parameters::epsilon, px); }
-  double getEpsilon() const { return params_.epsilon; }
-  void setMinEigenThreshold(double threshold)
-  {
-    updateField(&Parameters::min_eigen_threshold, threshold);
-  }
-  double getMinEigenThreshold() const { return params_.min_eigen_threshold; }
-  void setForwardBackwardCheck(ForwardBackwardCheck check)
-  {
-    updateField(&Parameters::forward_backward_check, check);
-  }
-  ForwardBackwardCheck getForwardBackwardCheck() const
-  {
-    return params_.forward_backward_check;
-  }
-  void setForwardBackwardThreshold(float px)
-  {
-    updateField(&Parameters::forward_backward_threshold, px);
-  }
-  float getForwardBackwardThreshold() const
-  {
-    return params_.forward_backward_threshold;
-  }
-  void setDepthEdgeTolerance(float ratio)
-  {
-    updateField(&Parameters::depth_edge_tolerance, ratio);
-  }
-  float getDepthEdgeTolerance() const { return params_.depth_edge_tolerance; }
-  void setDepthWindowRadius(int pixels)
-  {
-    updateField(&Parameters::depth_window_radius, pixels);
-  }
-  int getDepthWindowRadius() const { return params_.depth_window_radius; }
-  void setMaxFlow(float metres) { updateField(&Parameters::max_flow, metres); }
-  float getMaxFlow() const { return params_.max_flow; }
-  void setWeightReferenceDepth(float metres)
-  {
-    updateField(&Parameters::weight_reference_depth, metres);
-  }
-  float getWeightReferenceDepth() const { return params_.weight_reference_depth; }
+  // One setter/getter pair per field of Parameters. A setter throws std::invalid_argument
+  // when the value is outside the field's own range (GridSceneFlowParameters::table()) and
+  // keeps the old value; min_depth < max_depth is checked by compute().
+  DYNVO_PARAMETER_ACCESSORS(CellSize, cell_size)
+  DYNVO_PARAMETER_ACCESSORS(MinDepth, depth.min_depth)
+  DYNVO_PARAMETER_ACCESSORS(MaxDepth, depth.max_depth)
+  DYNVO_PARAMETER_ACCESSORS(FlyingPixelTolerance, depth.flying_pixel_tolerance)
+  DYNVO_PARAMETER_ACCESSORS(MaxHoleWidth, depth.max_hole_width)
+  DYNVO_PARAMETER_ACCESSORS(HoleFillTolerance, depth.hole_fill_tolerance)
+  DYNVO_PARAMETER_ACCESSORS(WindowSize, window_size)
+  DYNVO_PARAMETER_ACCESSORS(MaxPyramidLevel, max_pyramid_level)
+  DYNVO_PARAMETER_ACCESSORS(MaxIterations, max_iterations)
+  DYNVO_PARAMETER_ACCESSORS(Epsilon, epsilon)
+  DYNVO_PARAMETER_ACCESSORS(MinEigenThreshold, min_eigen_threshold)
+  DYNVO_PARAMETER_ACCESSORS(ForwardBackwardCheck, forward_backward_check)
+  DYNVO_PARAMETER_ACCESSORS(ForwardBackwardThreshold, forward_backward_threshold)
+  DYNVO_PARAMETER_ACCESSORS(DepthEdgeTolerance, depth_edge_tolerance)
+  DYNVO_PARAMETER_ACCESSORS(DepthWindowRadius, depth_window_radius)
+  DYNVO_PARAMETER_ACCESSORS(MaxFlow, max_flow)
+  DYNVO_PARAMETER_ACCESSORS(WeightReferenceDepth, weight_reference_depth)
 
 protected:
   using Base::deinitCompute;
@@ -195,20 +136,8 @@ protected:
   void prepareFrame(const PointCloud& cloud, detail::GridFlowEngine::Slot slot);
 
 private:
-  template <typename Field> void updateField(Field Parameters::*field, Field value)
-  {
-    Parameters updated = params_;
-    updated.*field = value;
-    setParameters(updated);
-  }
-
-  template <typename Field>
-  void updateDepthField(Field DepthPreprocessing::Parameters::*field, Field value)
-  {
-    Parameters updated = params_;
-    updated.depth.*field = value;
-    setParameters(updated);
-  }
+  /// Stores checked parameters and drops the prepared frames (they depend on them).
+  void assignParameters(const Parameters& parameters);
 
   std::string class_name_ = "GridSceneFlowEstimation"; ///< log prefix
   Parameters params_;                                  ///< validated knobs

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <dynvo/common/export.h>
+#include <dynvo/common/parameter_table.h>
 #include <dynvo/scene_flow/depth_preprocessing.h>
 
 namespace dynvo {
@@ -57,7 +58,11 @@ struct DYNVO_EXPORTS GridSceneFlowParameters {
   /// variance (sigma_z grows as z^2) relative to z_ref; z = the larger of the two depths.
   float weight_reference_depth = 1.5f;
 
-  /// \throws std::invalid_argument naming the first field out of the range stated above
+  /// Names, units and ranges of the fields above (depth as "depth.<field>"), in file order.
+  static const ParameterTable<GridSceneFlowParameters>& table();
+
+  /// \throws std::invalid_argument naming the first field out of the range stated above,
+  ///         or depth.validate()'s reason
   void validate() const;
 };
 

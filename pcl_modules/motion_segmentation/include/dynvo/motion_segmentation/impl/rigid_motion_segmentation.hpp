@@ -70,7 +70,7 @@ void
 RigidMotionSegmentation<PointT>::setParameters(const Parameters& parameters)
 {
   parameters.validate();
-  params_ = parameters;
+  assignParameters(parameters);
 }
 
 template <typename PointT>
@@ -190,6 +190,7 @@ RigidMotionSegmentation<PointT>::segment(std::vector<pcl::PointIndices>& segment
 {
   segments.clear();
   clearOutputs();
+  params_.validate(); // the per-field setters leave the cross-field rules to here
   if (!initCompute())
     return;
   struct DeinitGuard {

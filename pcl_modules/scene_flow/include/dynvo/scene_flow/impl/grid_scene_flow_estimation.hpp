@@ -63,6 +63,13 @@ void
 GridSceneFlowEstimation<PointT>::setParameters(const Parameters& parameters)
 {
   parameters.validate();
+  assignParameters(parameters);
+}
+
+template <typename PointT>
+void
+GridSceneFlowEstimation<PointT>::assignParameters(const Parameters& parameters)
+{
   params_ = parameters;
   // Pyramids depend on the LK window and levels, depth maps on the depth rules.
   current_ready_ = false;
@@ -129,6 +136,7 @@ void
 GridSceneFlowEstimation<PointT>::compute(FlowCloud& flow)
 {
   flow.clear();
+  params_.validate(); // the per-field setters leave the cross-field rules to here
   if (!initCompute())
     return;
   struct DeinitGuard {
