@@ -88,7 +88,7 @@ main(int argc, char** argv)
     const dynvo::app::Arguments args(argc, argv, options, 0);
     if (args.helpRequested()) {
       std::printf(
-          "Usage: %s\n\nComputes the grid scene flow (ALGORITHM.md section 1) between "
+          "Usage: %s\n\nComputes the grid scene flow (docs/algorithm.md section 1) between "
           "two consecutive frames.\nIn the PCD, x y z is the current point and prev_x "
           "prev_y prev_z the previous one (metres).\n\n%s",
           USAGE, args.optionsHelp().c_str());

@@ -35,10 +35,10 @@ struct DYNVO_EXPORTS PipelineOptions {
   PipelineOptions();
 
   CameraIntrinsics intrinsics;        ///< back-projection of the input frames
-  GridSceneFlowParameters scene_flow; ///< ALGORITHM.md §1
+  GridSceneFlowParameters scene_flow; ///< docs/algorithm.md §1
   RigidMotionSegmentationParameters
-      segmentation; ///< ALGORITHM.md §3-§6 (seed included)
-  StaticSceneRegistrationParameters registration; ///< ALGORITHM.md §7
+      segmentation; ///< docs/algorithm.md §3-§6 (seed included)
+  StaticSceneRegistrationParameters registration; ///< docs/algorithm.md §7
   bool use_segmentation =
       true; ///< false: ablation, every valid flow cell counts as static
   /// Static support (multiple of the segmentation's inlier threshold in use, 0 = off): after

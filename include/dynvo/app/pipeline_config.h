@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// YAML configuration of the odometry pipeline (ALGORITHM.md §9: every parameter configurable).
+// YAML configuration of the odometry pipeline (docs/algorithm.md §9: every parameter
+// configurable).
 #pragma once
 
 #include <dynvo/app/odometry_pipeline.h>

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// One field table per Parameters struct: names, units, ranges and access (STYLE.md §2.5).
+// One field table per Parameters struct: names, units, ranges and access
+// (docs/style.md §2.5).
 #pragma once
 
 #include <dynvo/common/export.h>

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The only translation unit that parses PCL's ICP and GICP templates (STYLE.md §2.4).
+// The only translation unit that parses PCL's ICP and GICP templates (docs/style.md
+// §2.4).
 #include <dynvo/registration/rigid_refinement.h>
 
 #include <pcl/registration/gicp.h>

@@ -22,7 +22,7 @@ using dynvo::test::cellPixels;
 using dynvo::test::rotationErrorDeg;
 using dynvo::test::translationError;
 
-constexpr std::uint32_t CELL = 16; // w_grid (px), ALGORITHM.md §0
+constexpr std::uint32_t CELL = 16; // w_grid (px), docs/algorithm.md §0
 
 // Noise-free correspondences are float copies of exact points at <= 4 m: round-off is
 // ~2e-7 m per coordinate, so 1 mm and 0.05 degrees (the brief's accuracy) leave a margin of

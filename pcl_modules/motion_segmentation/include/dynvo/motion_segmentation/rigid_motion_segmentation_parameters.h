@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Every knob of the rigid motion segmentation and tracking stages (ALGORITHM.md §3-§6, §9).
+// Every knob of the rigid motion segmentation and tracking stages (docs/algorithm.md
+// §3-§6, §9).
 #pragma once
 
 #include <dynvo/common/export.h>
@@ -11,7 +12,8 @@ namespace dynvo {
 
 /** \brief Parameters of RigidMotionSegmentation (the single source of the defaults).
  *
- * Names in parentheses are the ALGORITHM.md §9 symbols. Validation ranges follow each field.
+ * Names in parentheses are the docs/algorithm.md §9 symbols. Validation ranges follow
+ * each field.
  */
 struct DYNVO_EXPORTS RigidMotionSegmentationParameters {
   /// w_grid (px, >= 2): must equal the scene flow's cell size
@@ -22,7 +24,7 @@ struct DYNVO_EXPORTS RigidMotionSegmentationParameters {
   int max_trials = 200;
   /// m (>= 3): points per hypothesis
   int sample_size = 7;
-  /// r_search (grid cells, Chebyshev, >= 1): seed neighbourhood. ALGORITHM.md says 2 (5x5);
+  /// r_search (grid cells, Chebyshev, >= 1): seed neighbourhood. The paper says 2 (5x5);
   /// 1 (3x3) is our default: a 5x5 window around a seed on an object of 6x3 cells (0.6 x 0.3 m
   /// at 3 m) nearly always holds boundary cells with mixed flow, so its 7-point samples fail.
   /// Measured on static_two (VGA, 40 frames): moving-object cell IoU 0.62 with 2, 0.81 with 1.
@@ -36,7 +38,7 @@ struct DYNVO_EXPORTS RigidMotionSegmentationParameters {
   float entropy_delta = 1e-2f;
   /// refine_iters (>= 1): inlier/refit rounds per hypothesis
   int refine_iterations = 2;
-  /// s_done (0..1): mean entropy low enough to stop. ALGORITHM.md says 0.15, but objects
+  /// s_done (0..1): mean entropy low enough to stop. The paper says 0.15, but objects
   /// cover a few % of the cells, so the mean is below 0.15 as soon as the background is
   /// explained and the search stopped before any object was hypothesised (IoU 0.28 on
   /// static_two). 0.012 = the floor S_min = 1 - e^-delta (0.00995) + 0.2 %: stop only when

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Ego-motion from the static part of the scene (ALGORITHM.md §7) as a pcl::Registration.
+// Ego-motion from the static part of the scene (docs/algorithm.md §7) as a
+// pcl::Registration.
 #pragma once
 
 #include <dynvo/common/export.h>
@@ -31,7 +32,7 @@ enum class StaticRegistrationStatus {
 
 /** \brief Camera ego-motion from the static cells of a grid scene flow: Lee, Son & Kim, "Robust
  * Real-time RGB-D Visual Odometry in Dynamic Environments via Rigid Motion Model", IROS 2019
- * (arXiv 1907.08388), §III-D; ALGORITHM.md §7.
+ * (arXiv 1907.08388), §III-D; docs/algorithm.md §7.
  *
  * PCL's naming applies: the source (setInputSource) is the current frame k, setIndices() holds
  * its static pixels (linear indices row * width + col), the target (setInputTarget) is the

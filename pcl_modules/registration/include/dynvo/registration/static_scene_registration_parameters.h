@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Every knob of the static-scene ego-motion stage (ALGORITHM.md §7 and §9).
+// Every knob of the static-scene ego-motion stage (docs/algorithm.md §7 and §9).
 #pragma once
 
 #include <dynvo/common/export.h>
@@ -16,7 +16,8 @@ enum class RegistrationRefinement {
 
 /** \brief Parameters of StaticSceneRegistration (the single source of the defaults).
  *
- * The flow estimate follows ALGORITHM.md §7: a weighted least-squares fit on the static cells,
+ * The flow estimate follows docs/algorithm.md §7: a weighted least-squares fit on the
+ * static cells,
  * then trim_rounds rounds that keep the cells with E_i <= trim_factor * th_inlier and refit.
  * The refinement_* fields only matter when refinement != none.
  */

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Every knob of the grid scene flow stage (ALGORITHM.md §1 and §9).
+// Every knob of the grid scene flow stage (docs/algorithm.md §1 and §9).
 #pragma once
 
 #include <dynvo/common/export.h>
@@ -8,39 +8,42 @@
 
 namespace dynvo {
 
-/// How the forward-backward check of ALGORITHM.md §1.2 tracks p_i back into the current image.
+/// How the forward-backward check of docs/algorithm.md §1.2 tracks p_i back into the
+/// current image.
 enum class ForwardBackwardCheck {
-  full, ///< from scratch through the whole pyramid, as ALGORITHM.md §1.2 states (cost x2)
+  full, ///< from scratch through the whole pyramid, as the paper states (cost x2)
   local, ///< started at c_i on the finest level only (about a quarter of the forward cost):
   ///< rejects tracks whose reverse LK does not stay at c_i, not far-away wrong matches
 };
 
 /** \brief Parameters of GridSceneFlowEstimation (the single source of the defaults).
  *
- * The Lucas-Kanade defaults differ from ALGORITHM.md §1.2 (window 21, maxLevel 3, 30 iterations,
+ * The Lucas-Kanade defaults differ from the paper's (docs/algorithm.md §1.2: window
+ * 21, maxLevel 3, 30 iterations,
  * eps 0.01, backward track from scratch): those cost about 25 ms per VGA frame on one core of
- * the target machine (PLATFORM.md), against a budget of 8 ms for the whole stage. Window 13,
+ * the target machine (docs/platform.md), against a budget of 8 ms for the whole stage.
+ * Window 13,
  * maxLevel 2, 8 iterations, eps 0.03 and the local check keep the synthetic end-point error at
  * about 0.1 px (VGA, 15-27 px of flow) and the share of valid cells on TUM fr1/xyz within 3
- * points of the ALGORITHM.md settings; the measurements are in pcl_modules/scene_flow/NOTES.md.
+ * points of the paper's settings; the measurements are in pcl_modules/scene_flow/NOTES.md.
  */
 struct DYNVO_EXPORTS GridSceneFlowParameters {
   /// w_grid (px, >= 2): cell size; cell (col, row) is centred on pixel
   /// (col, row) * cell_size + cell_size / 2.
   int cell_size = 16;
-  /// z_min, z_max, tau_fly, w_hole, tau_fill (ALGORITHM.md §1.1).
+  /// z_min, z_max, tau_fly, w_hole, tau_fill (docs/algorithm.md §1.1).
   DepthPreprocessing::Parameters depth;
-  /// LK win (px, >= 3): side of the square LK window (ALGORITHM.md: 21).
+  /// LK win (px, >= 3): side of the square LK window (paper: 21).
   int window_size = 13;
-  /// LK levels (>= 0): OpenCV maxLevel, 0 = no pyramid (ALGORITHM.md: 3).
+  /// LK levels (>= 0): OpenCV maxLevel, 0 = no pyramid (paper: 3).
   int max_pyramid_level = 2;
-  /// LK iters (>= 1): iteration cap per pyramid level (ALGORITHM.md: 30).
+  /// LK iters (>= 1): iteration cap per pyramid level (paper: 30).
   int max_iterations = 8;
-  /// LK eps (px, > 0): stop iterating when an update is shorter (ALGORITHM.md: 0.01).
+  /// LK eps (px, > 0): stop iterating when an update is shorter (paper: 0.01).
   double epsilon = 0.03;
   /// OpenCV minEigThreshold (> 0): rejects textureless windows.
   double min_eigen_threshold = 1e-4;
-  /// Backward tracking scheme of the forward-backward check (ALGORITHM.md: full).
+  /// Backward tracking scheme of the forward-backward check (paper: full).
   ForwardBackwardCheck forward_backward_check = ForwardBackwardCheck::local;
   /// fb_max (px, > 0): largest |c' - c| accepted by the forward-backward check.
   float forward_backward_threshold = 1.0f;
@@ -50,7 +53,7 @@ struct DYNVO_EXPORTS GridSceneFlowParameters {
   /// plane fitted in inverse depth (exact for planar surfaces) to every other pixel of the
   /// (2r + 1)^2 window around the point whose depth is within tau_edge of the single-pixel
   /// value, evaluated at the point. This averages out most of the sensor's per-pixel noise
-  /// and disparity quantisation; 0 = ALGORITHM.md §1.2's single pixel.
+  /// and disparity quantisation; 0 = the paper's single pixel.
   int depth_window_radius = 0;
   /// max_flow3d (metres per frame, > 0): a larger |b - a| is a gross error.
   float max_flow = 0.5f;

@@ -145,7 +145,8 @@ StaticSceneRegistration<PointT>::estimateFromFlow()
   }
   inliers_.assign(count, 1);
   inlier_count_ = count;
-  // ALGORITHM.md §7: keep E_i <= trim_factor * th_inlier and refit, trim_rounds times.
+  // docs/algorithm.md §7: keep E_i <= trim_factor * th_inlier and refit, trim_rounds
+  // times.
   const double trim_threshold =
       static_cast<double>(params_.trim_factor) * static_cast<double>(params_.th_inlier);
   std::vector<std::uint8_t> kept(count);
