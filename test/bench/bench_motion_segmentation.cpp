@@ -61,15 +61,19 @@ void
 BM_SpatialSegmentation(benchmark::State& state)
 {
   const std::vector<FlowFrame>& frames = sequence(state.range(0) == 1);
-  std::vector<dynvo::GridFlowData> grids(frames.size());
-  for (std::size_t k = 0; k < frames.size(); ++k)
-    grids[k].assign(*frames[k].flow, 16);
   const dynvo::RigidMotionSegmentationParameters params;
+  std::vector<dynvo::GridFlowData> grids(frames.size());
+  std::vector<std::vector<Eigen::Matrix3f>> information(frames.size());
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    grids[k].assign(*frames[k].flow, 16);
+    information[k] = grids[k].transferInformation(params.noise, 525.0f, 1.0f, 1.0f);
+  }
   dynvo::SpatialSegmenter segmenter;
   dynvo::SpatialSegmentationResult result;
   std::size_t k = 0;
   for (auto _ : state) {
-    segmenter.segment(grids[k++ % grids.size()], params, result);
+    const std::size_t f = k++ % grids.size();
+    segmenter.segment(grids[f], params, information[f], result);
     benchmark::DoNotOptimize(result.labels.data());
   }
 }
@@ -122,7 +126,9 @@ BM_SegmentTracking(benchmark::State& state)
   dynvo::SpatialSegmenter segmenter;
   for (std::size_t k = 0; k < frames.size(); ++k) {
     grids[k].assign(*frames[k].flow, params.cell_size);
-    segmenter.segment(grids[k], params, spatial[k]);
+    segmenter.segment(grids[k], params,
+                      grids[k].transferInformation(params.noise, 525.0f, 1.0f, 1.0f),
+                      spatial[k]);
   }
   dynvo::SegmentTracker tracker;
   std::size_t k = 0;

@@ -33,4 +33,18 @@ GridFlowData::assign(const pcl::PointCloud<PointFlow>& flow, int cell_size_px)
   }
 }
 
+std::vector<Eigen::Matrix3f>
+GridFlowData::transferInformation(const SensorNoiseModel& noise,
+                                  float focal,
+                                  float axial_gain,
+                                  float lateral_gain) const
+{
+  std::vector<Eigen::Matrix3f> information(size(), Eigen::Matrix3f::Zero());
+  for (std::size_t i = 0; i < size(); ++i)
+    if (valid_3d[i])
+      information[i] =
+          noise.transferInformation(a[i], b[i], focal, axial_gain, lateral_gain);
+  return information;
+}
+
 } // namespace dynvo

@@ -37,7 +37,12 @@ segmentFlow(const dynvo::test::SyntheticFlow& synthetic,
   grid.assign(*synthetic.flow, CELL);
   dynvo::SpatialSegmenter segmenter;
   dynvo::SpatialSegmentationResult result;
-  segmenter.segment(grid, params, result);
+  const bool sensor = params.residual_model == dynvo::ResidualModel::sensor;
+  segmenter.segment(grid, params,
+                    sensor ? grid.transferInformation(params.noise,
+                                                      static_cast<float>(smallIntrinsics().fx), 1.0f, 1.0f)
+                           : std::vector<Eigen::Matrix3f>{},
+                    result);
   return result;
 }
 
@@ -175,13 +180,13 @@ TEST(SpatialSegmentation, MotionFieldDistanceOfTwoTranslations)
   y.T_curr_prev = makeMotion({0, 0, 1}, 0.0, {0.01, 0.004, 0.0});
   x.inliers = {0, 1};
   y.inliers = {1, 2};
-  EXPECT_NEAR(dynvo::motionFieldDistance(x, y, a), 0.004, 1e-12);
+  EXPECT_NEAR(dynvo::motionFieldDistance(x, y, a, {}), 0.004, 1e-12);
   // A rotation by 0.01 rad about the optical axis moves the points of the union {0, 2}
   // by 0.01 * |(x, y)|, i.e. by 0 and 0.01 m: RMS = sqrt((0 + 1e-4) / 2).
   y.T_curr_prev = makeMotion({0, 0, 1}, 0.01, {0.01, 0.0, 0.0});
   x.inliers = {0};
   y.inliers = {2};
-  EXPECT_NEAR(dynvo::motionFieldDistance(x, y, a), std::sqrt(1e-4 / 2.0), 1e-6);
+  EXPECT_NEAR(dynvo::motionFieldDistance(x, y, a, {}), std::sqrt(1e-4 / 2.0), 1e-6);
 }
 
 /// Distance matrix of items on a line at the given positions.

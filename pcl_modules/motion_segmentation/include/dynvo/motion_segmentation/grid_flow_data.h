@@ -4,6 +4,7 @@
 
 #include <dynvo/common/export.h>
 #include <dynvo/common/point_types.h>
+#include <dynvo/common/sensor_noise_model.h>
 
 #include <pcl/point_cloud.h>
 
@@ -51,6 +52,15 @@ struct DYNVO_EXPORTS GridFlowData {
    * \param[in] cell_size w_grid (px) the flow was computed with
    */
   void assign(const pcl::PointCloud<PointFlow>& flow, int cell_size);
+
+  /** \brief Information matrix of each cell's transfer error under the sensor model,
+   * noise.transferInformation(a_i, b_i, focal, axial_gain, lateral_gain); zero for cells
+   * without valid_3d.
+   */
+  std::vector<Eigen::Matrix3f> transferInformation(const SensorNoiseModel& noise,
+                                                   float focal,
+                                                   float axial_gain,
+                                                   float lateral_gain) const;
 };
 
 } // namespace dynvo

@@ -17,6 +17,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -104,6 +105,9 @@ public:
   /// The tracker state (tracked labels Ghat, model labels L, docs/algorithm.md §4-§6).
   const SegmentTracker& getTracker() const { return tracker_; }
 
+  /// The sensor model's gains {axial, lateral} for the next segment() (1 after reset()).
+  const std::array<float, 2>& getNoiseGains() const { return noise_gains_; }
+
   /** \brief Forgets the sequence (label buffer and models): the next segment() starts a new
    * one. Parameter setters keep the sequence; a new grid size or max_labels restarts it.
    */
@@ -185,6 +189,16 @@ private:
   /// Clears every output of segment().
   void clearOutputs();
 
+  /// information_: per cell W_i of the sensor model with noise_gains_ (empty for the
+  /// paper model).
+  void computeInformation();
+
+  /// Fits noise_gains_ to the static cells' residuals under the background motion.
+  void updateNoiseScale();
+
+  /// Mean of fx and fy (px).
+  float focalLength() const;
+
   std::string class_name_ = "RigidMotionSegmentation"; ///< log prefix
   Parameters params_;                                  ///< validated knobs
   CameraIntrinsics intrinsics_; ///< current-frame intrinsics (default preset)
@@ -199,6 +213,10 @@ private:
   std::vector<std::uint8_t> cell_labels_;    ///< output label per cell
   std::vector<std::uint8_t> segment_labels_; ///< id of each output segment
   Motions motions_;                          ///< T_curr_prev of each output segment
+  std::vector<Eigen::Matrix3f> information_; ///< W_i per cell (sensor model)
+  /// s_axial, s_lateral: the sensor model's gains on its axial and lateral sigma, fitted
+  /// over the frames
+  std::array<float, 2> noise_gains_{1.0f, 1.0f};
 };
 
 } // namespace dynvo
