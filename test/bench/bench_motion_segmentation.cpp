@@ -63,17 +63,15 @@ BM_SpatialSegmentation(benchmark::State& state)
   const std::vector<FlowFrame>& frames = sequence(state.range(0) == 1);
   const dynvo::RigidMotionSegmentationParameters params;
   std::vector<dynvo::GridFlowData> grids(frames.size());
-  std::vector<std::vector<Eigen::Matrix3f>> information(frames.size());
   for (std::size_t k = 0; k < frames.size(); ++k) {
     grids[k].assign(*frames[k].flow, 16);
-    information[k] = grids[k].transferInformation(params.noise, 525.0f, 1.0f, 1.0f);
+    grids[k].setSensorNoise(params.noise, 525.0f, 1.0f, 1.0f);
   }
   dynvo::SpatialSegmenter segmenter;
   dynvo::SpatialSegmentationResult result;
   std::size_t k = 0;
   for (auto _ : state) {
-    const std::size_t f = k++ % grids.size();
-    segmenter.segment(grids[f], params, information[f], result);
+    segmenter.segment(grids[k++ % grids.size()], params, result);
     benchmark::DoNotOptimize(result.labels.data());
   }
 }
@@ -126,9 +124,8 @@ BM_SegmentTracking(benchmark::State& state)
   dynvo::SpatialSegmenter segmenter;
   for (std::size_t k = 0; k < frames.size(); ++k) {
     grids[k].assign(*frames[k].flow, params.cell_size);
-    segmenter.segment(grids[k], params,
-                      grids[k].transferInformation(params.noise, 525.0f, 1.0f, 1.0f),
-                      spatial[k]);
+    grids[k].setSensorNoise(params.noise, 525.0f, 1.0f, 1.0f);
+    segmenter.segment(grids[k], params, spatial[k]);
   }
   dynvo::SegmentTracker tracker;
   std::size_t k = 0;

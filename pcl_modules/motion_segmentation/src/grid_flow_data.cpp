@@ -20,6 +20,7 @@ GridFlowData::assign(const pcl::PointCloud<PointFlow>& flow, int cell_size_px)
   previous_pixel.resize(n);
   a.resize(n);
   b.resize(n);
+  information.clear();
   for (std::size_t i = 0; i < n; ++i) {
     const PointFlow& f = flow[i];
     valid_2d[i] = f.valid_2d && std::isfinite(f.prev_u) && std::isfinite(f.prev_v);
@@ -33,18 +34,17 @@ GridFlowData::assign(const pcl::PointCloud<PointFlow>& flow, int cell_size_px)
   }
 }
 
-std::vector<Eigen::Matrix3f>
-GridFlowData::transferInformation(const SensorNoiseModel& noise,
-                                  float focal,
-                                  float axial_gain,
-                                  float lateral_gain) const
+void
+GridFlowData::setSensorNoise(const SensorNoiseModel& noise,
+                             float focal,
+                             float axial_gain,
+                             float lateral_gain)
 {
-  std::vector<Eigen::Matrix3f> information(size(), Eigen::Matrix3f::Zero());
+  information.assign(size(), Eigen::Matrix3f::Zero());
   for (std::size_t i = 0; i < size(); ++i)
     if (valid_3d[i])
       information[i] =
           noise.transferInformation(a[i], b[i], focal, axial_gain, lateral_gain);
-  return information;
 }
 
 } // namespace dynvo

@@ -274,8 +274,6 @@ SpatialSegmenter::label(const std::vector<int>& clusters,
   for (const int c : assigned)
     if (c >= 0)
       ++sizes[c];
-  if (!w_.empty())
-    mergeIntoLargest(motions, sizes, assigned);
   // 3. Dissolve small segments, renumber by size (largest first), refit on final points.
   std::vector<int> order;
   for (std::size_t c = 0; c < motions.size(); ++c)
@@ -304,52 +302,17 @@ SpatialSegmenter::label(const std::vector<int>& clusters,
 }
 
 void
-SpatialSegmenter::mergeIntoLargest(const std::vector<Eigen::Matrix4d>& motions,
-                                   std::vector<int>& sizes,
-                                   std::vector<int>& assigned) const
-{
-  if (sizes.empty())
-    return;
-  const int largest =
-      static_cast<int>(std::max_element(sizes.begin(), sizes.end()) - sizes.begin());
-  const RigidF m(motions[largest]);
-  // [D] Sensor model: a segment whose typical cell is explained by the largest segment's
-  // motion (median E_i within th_chi2 / 4, about 2 sigma) is the same motion split by
-  // noise; its cells join the largest segment.
-  std::vector<std::vector<float>> errors(sizes.size());
-  const int n = static_cast<int>(assigned.size());
-  for (int k = 0; k < n; ++k)
-    if (assigned[k] >= 0 && assigned[k] != largest)
-      errors[assigned[k]].push_back(error(m.R, m.t, k));
-  std::vector<char> merge(sizes.size(), 0);
-  for (std::size_t c = 0; c < sizes.size(); ++c) {
-    std::vector<float>& e = errors[c];
-    if (e.empty())
-      continue;
-    const auto middle = e.begin() + static_cast<std::ptrdiff_t>(e.size() / 2);
-    std::nth_element(e.begin(), middle, e.end());
-    merge[c] = *middle <= 0.25f * th_.inlier;
-  }
-  for (int& c : assigned)
-    if (c >= 0 && merge[c]) {
-      --sizes[c];
-      ++sizes[largest];
-      c = largest;
-    }
-}
-
-void
 SpatialSegmenter::segment(const GridFlowData& grid,
                           const RigidMotionSegmentationParameters& params,
-                          const std::vector<Eigen::Matrix3f>& information,
                           SpatialSegmentationResult& result)
 {
   th_ = ResidualThresholds::of(params);
+  result.inlier_threshold = th_.inlier;
   if ((params.residual_model == ResidualModel::sensor) !=
-      (information.size() == grid.size()))
+      (grid.information.size() == grid.size()))
     throw std::invalid_argument(
-        "[dynvo::SpatialSegmenter::segment] the sensor model needs one information "
-        "matrix per cell, the paper model none");
+        "[dynvo::SpatialSegmenter::segment] the sensor model needs the grid's "
+        "information matrices (GridFlowData::setSensorNoise), the paper model none");
   result.labels.assign(grid.size(), 0);
   result.motions.clear();
   result.sizes.clear();
@@ -368,8 +331,8 @@ SpatialSegmenter::segment(const GridFlowData& grid,
       cell_of_packed_.push_back(static_cast<int>(i));
       a_.push_back(grid.a[i]);
       b_.push_back(grid.b[i]);
-      if (!information.empty())
-        w_.push_back(information[i]);
+      if (!grid.information.empty())
+        w_.push_back(grid.information[i]);
     }
   const std::size_t n = a_.size();
   if (static_cast<int>(n) < 2 * params.sample_size)

@@ -35,14 +35,12 @@ segmentFlow(const dynvo::test::SyntheticFlow& synthetic,
 {
   dynvo::GridFlowData grid;
   grid.assign(*synthetic.flow, CELL);
+  if (params.residual_model == dynvo::ResidualModel::sensor)
+    grid.setSensorNoise(params.noise, static_cast<float>(smallIntrinsics().fx), 1.0f,
+                        1.0f);
   dynvo::SpatialSegmenter segmenter;
   dynvo::SpatialSegmentationResult result;
-  const bool sensor = params.residual_model == dynvo::ResidualModel::sensor;
-  segmenter.segment(grid, params,
-                    sensor ? grid.transferInformation(params.noise,
-                                                      static_cast<float>(smallIntrinsics().fx), 1.0f, 1.0f)
-                           : std::vector<Eigen::Matrix3f>{},
-                    result);
+  segmenter.segment(grid, params, result);
   return result;
 }
 

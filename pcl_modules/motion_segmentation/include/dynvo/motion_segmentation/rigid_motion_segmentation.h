@@ -189,8 +189,7 @@ private:
   /// Clears every output of segment().
   void clearOutputs();
 
-  /// information_: per cell W_i of the sensor model with noise_gains_ (empty for the
-  /// paper model).
+  /// The grid's information matrices for the sensor model, with noise_gains_.
   void computeInformation();
 
   /// Fits noise_gains_ to the static cells' residuals under the background motion.
@@ -213,7 +212,6 @@ private:
   std::vector<std::uint8_t> cell_labels_;    ///< output label per cell
   std::vector<std::uint8_t> segment_labels_; ///< id of each output segment
   Motions motions_;                          ///< T_curr_prev of each output segment
-  std::vector<Eigen::Matrix3f> information_; ///< W_i per cell (sensor model)
   /// s_axial, s_lateral: the sensor model's gains on its axial and lateral sigma, fitted
   /// over the frames
   std::array<float, 2> noise_gains_{1.0f, 1.0f};

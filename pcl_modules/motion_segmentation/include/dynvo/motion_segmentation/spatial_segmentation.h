@@ -30,6 +30,7 @@ struct SpatialSegmentationResult {
   std::vector<MotionHypothesis>
       hypotheses; ///< accepted hypotheses, inliers as cell indices
   int trials = 0; ///< trials made, failed ones included
+  float inlier_threshold = 0.0f; ///< th of this result, in the unit of E_i
 
   /// Number of segments g.
   int segmentCount() const { return static_cast<int>(sizes.size()); }
@@ -84,16 +85,13 @@ struct DYNVO_EXPORTS ResidualThresholds {
  */
 class DYNVO_EXPORTS SpatialSegmenter {
 public:
-  /** \param[in] grid scene flow of the frame pair
+  /** \param[in] grid scene flow of the frame pair, with information for the sensor model
    *  \param[in] params validated parameters
-   *  \param[in] information per cell, the information matrix W_i of the transfer error
-   *             (E_i = e^T W_i e, sensor model), or empty for W_i = I (paper model)
    *  \param[out] result labels per cell and one motion per segment (all 0 and no segment
    *              when fewer than 2 m cells are valid_3d)
    */
   void segment(const GridFlowData& grid,
                const RigidMotionSegmentationParameters& params,
-               const std::vector<Eigen::Matrix3f>& information,
                SpatialSegmentationResult& result);
 
 private:
@@ -115,12 +113,6 @@ private:
   void label(const std::vector<int>& clusters,
              const RigidMotionSegmentationParameters& params,
              SpatialSegmentationResult& result);
-
-  /// Sensor model: the segments (by motion index) the largest one's motion explains join
-  /// it (docs/algorithm.md §3.6).
-  void mergeIntoLargest(const std::vector<Eigen::Matrix4d>& motions,
-                        std::vector<int>& sizes,
-                        std::vector<int>& assigned) const;
 
   int cols_ = 0;                    ///< grid columns
   int rows_ = 0;                    ///< grid rows

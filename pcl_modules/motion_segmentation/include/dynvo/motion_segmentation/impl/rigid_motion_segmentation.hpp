@@ -202,7 +202,7 @@ RigidMotionSegmentation<PointT>::segment(std::vector<pcl::PointIndices>& segment
     return;
   grid_.assign(*flow_, params_.cell_size);
   computeInformation();
-  segmenter_.segment(grid_, params_, information_, spatial_);
+  segmenter_.segment(grid_, params_, spatial_);
   PCL_DEBUG("[dynvo::%s::segment] %d segments from %zu hypotheses (%d trials).\n",
             getClassName().c_str(), spatial_.segmentCount(), spatial_.hypotheses.size(),
             spatial_.trials);
@@ -233,26 +233,25 @@ template <typename PointT>
 void
 RigidMotionSegmentation<PointT>::computeInformation()
 {
-  information_.clear();
   if (params_.residual_model != ResidualModel::sensor)
     return;
   for (float& gain : noise_gains_)
     gain = std::clamp(gain, params_.noise_scale_min, params_.noise_scale_max);
-  information_ = grid_.transferInformation(params_.noise, focalLength(),
-                                           noise_gains_[0], noise_gains_[1]);
+  grid_.setSensorNoise(params_.noise, focalLength(), noise_gains_[0], noise_gains_[1]);
 }
 
 template <typename PointT>
 void
 RigidMotionSegmentation<PointT>::updateNoiseScale()
 {
-  if (information_.empty() || motions_.empty())
+  if (grid_.information.empty() || motions_.empty())
     return;
-  // On the static cells, the axial part of the transfer error over its model variance is
+  // On static cells, the axial part of the transfer error over its model variance is
   // chi-square with 1 degree of freedom (median 0.455), the lateral part with 2 (median
-  // 1.386), when the model's shape holds. Each gain is scaled by the ratio of the observed
-  // median to that; the cells kept by E_i <= th_chi2 = 16 cut the tail only, so the
-  // estimate does not shrink from frame to frame.
+  // 1.386), when the model's shape holds; each gain is the root of the observed median
+  // over that. The cells are every valid cell within 4 th_chi2 (about 8 sigma) of the
+  // background's motion, not only label 1: when noise splits the background, label 1 is
+  // the part that fits best, and its residuals alone would shrink the gains frame by frame.
   constexpr float MEDIAN[2] = {0.455f, 1.386f};
   constexpr std::size_t MIN_CELLS = 30;
   const float focal = focalLength();
@@ -260,7 +259,7 @@ RigidMotionSegmentation<PointT>::updateNoiseScale()
   const Eigen::Vector3f t = motions_[0].topRightCorner<3, 1>();
   std::array<std::vector<float>, 2> ratios;
   for (std::size_t i = 0; i < grid_.size(); ++i)
-    if (cell_labels_[i] == LABEL_STATIC && grid_.valid_3d[i]) {
+    if (grid_.valid_3d[i] && grid_.error(i, R, t) <= 4.0f * params_.inlier_chi2) {
       const Eigen::Vector3f& a = grid_.a[i];
       const Eigen::Vector3f& b = grid_.b[i];
       const Eigen::Vector3f e = R * a + t - b;
