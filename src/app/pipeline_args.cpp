@@ -64,7 +64,7 @@ parameterFlags()
       {"no_segmentation",
        {"pipeline.use_segmentation"},
        "",
-       "ablation: every valid flow cell counts as static (no object labels)",
+       "ablation: every valid flow cell counts as static, no object labels",
        S::all},
       {"refine",
        {"registration.refinement"},
