@@ -2,13 +2,12 @@
 // Bad input through the apps: every case checks the exit code, that the message names the
 // file, and that a file already at an output path is untouched (issue 17). The fixtures
 // are made here: a small synthetic sequence, then one thing broken per case.
-#include <dynvo/app/synthesize.h>
 #include <dynvo/io/trajectory_io.h>
-#include <dynvo/synth/scene_synthesizer.h>
 
 #include <gtest/gtest.h>
 
 #include "support/run_command.h"
+#include "support/synthetic_sequence.h"
 #include "support/temp_dir.h"
 
 #include <opencv2/core.hpp>
@@ -40,13 +39,7 @@ class Reliability : public ::testing::Test {
 protected:
   static void SetUpTestSuite()
   {
-    sequence_ = new TempDir();
-    dynvo::SynthOptions options;
-    options.scenario = "static_one";
-    options.frames = FRAMES;
-    options.width = 160;
-    options.height = 120;
-    dynvo::app::writeSyntheticSequence(options, sequence_->file("seq"), 2);
+    sequence_ = new dynvo::test::SyntheticSequence("static_one", FRAMES, 160, 120);
   }
 
   static void TearDownTestSuite() { delete sequence_; }
@@ -55,7 +48,7 @@ protected:
   std::string copy() const
   {
     const std::string seq = dir_.file("seq");
-    fs::copy(sequence_->file("seq"), seq, fs::copy_options::recursive);
+    fs::copy(sequence_->path(), seq, fs::copy_options::recursive);
     return seq;
   }
 
@@ -81,11 +74,11 @@ protected:
   }
 
   static constexpr int FRAMES = 12;
-  static TempDir* sequence_;
+  static dynvo::test::SyntheticSequence* sequence_;
   TempDir dir_;
 };
 
-TempDir* Reliability::sequence_ = nullptr;
+dynvo::test::SyntheticSequence* Reliability::sequence_ = nullptr;
 
 /// The exit code and the file named in the message; the first stderr line is the error.
 void
@@ -125,25 +118,25 @@ TEST_F(Reliability, SizeChangeMidRunKeepsWhatWasComputed)
   EXPECT_TRUE(fs::exists(dir_.file("o.txt")));
   EXPECT_FALSE(fs::exists(dir_.file("o.txt.partial")));
 
-  // dynvo_segment takes a size change as a frame without flow (PCL's contract), so
-  // a corrupt 7th image stops it instead.
-  writeText(listed(seq, "rgb.txt", 6), "not a PNG");
+  // dynvo_segment runs the same pipeline, so the size change stops it the same way.
   const auto segment =
       runCommand(SEGMENT + " -tum_dir " + seq + " -out_dir " + dir_.file("masks") +
                  " -objects " + dir_.file("s.txt"));
   expectFailure(segment, 1, listed(seq, "rgb.txt", 6));
+  EXPECT_NE(segment.err.find("frame size changed"), std::string::npos) << segment.err;
   EXPECT_NE(segment.err.find("stopped after 6 frames"), std::string::npos)
       << segment.err;
   EXPECT_EQ(std::distance(fs::directory_iterator(dir_.file("masks")),
                           fs::directory_iterator()),
             6);
   EXPECT_TRUE(fs::exists(dir_.file("s.txt")));
+  EXPECT_FALSE(fs::exists(dir_.file("s.txt.partial")));
 }
 
 /// No output may be, or lie inside, anything the run reads (defect 2).
 TEST_F(Reliability, OutputsOverInputsAreRefused)
 {
-  const std::string seq = sequence_->file("seq");
+  const std::string seq = sequence_->path();
   const std::string groundtruth = readText(seq + "/groundtruth.txt");
   const std::string rgb = listed(seq, "rgb.txt", 0);
   const std::string first_rgb = readText(rgb);
@@ -197,13 +190,18 @@ TEST_F(Reliability, FirstFrameFailureReplacesNothing)
   EXPECT_EQ(readText(objects), KEEP);
   EXPECT_FALSE(fs::exists(out + ".partial"));
   EXPECT_FALSE(fs::exists(objects + ".partial"));
+  const auto segment = runCommand(SEGMENT + " -tum_dir " + seq + " -out_dir " +
+                                  dir_.file("masks") + " -objects " + objects);
+  expectFailure(segment, 1, rgb);
+  EXPECT_EQ(readText(objects), KEEP);
+  EXPECT_FALSE(fs::exists(objects + ".partial"));
 }
 
 /// Output paths are checked before the first frame, exit 2 (defect 4, and defect 8's
 /// "-render_dir <a file>").
 TEST_F(Reliability, OutputPathsAreCheckedUpFront)
 {
-  const std::string run = ODOMETRY + " -tum_dir " + sequence_->file("seq");
+  const std::string run = ODOMETRY + " -tum_dir " + sequence_->path();
   const std::string out = existing("t.txt");
   expectRefusedUpFront(runCommand(run + " -out " + dir_.file("missing/t.txt")),
                        "folder '" + dir_.file("missing") + "' does not exist");
