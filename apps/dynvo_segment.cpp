@@ -98,7 +98,6 @@ main(int argc, char** argv)
     segmentation.setNumberOfThreads(static_cast<unsigned>(threads));
     segmentation.setSeed(static_cast<std::uint32_t>(seed));
     segmentation.setTracking(!args.has("no_tracking"));
-    flow_estimation.setCellSize(segmentation.getCellSize());
 
     pcl::PointCloud<dynvo::PointFlow>::Ptr flow(new pcl::PointCloud<dynvo::PointFlow>);
     std::vector<pcl::PointIndices> segments;

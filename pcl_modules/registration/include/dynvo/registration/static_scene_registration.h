@@ -4,6 +4,7 @@
 #pragma once
 
 #include <dynvo/common/export.h>
+#include <dynvo/common/flow_grid.h>
 #include <dynvo/common/point_types.h>
 #include <dynvo/registration/static_scene_registration_parameters.h>
 
@@ -41,18 +42,20 @@ enum class StaticRegistrationStatus {
  *
  * Flow estimate (no nearest-neighbour search): the flow grid (setInputFlow, from
  * GridSceneFlowEstimation on the same frame pair) gives per cell b_i (x, y, z; current frame)
- * and a_i (prev_x, prev_y, prev_z; previous frame). Cell geometry: cell_size = width / flow.width
- * (integer division), and height / cell_size must equal flow.height. A static pixel (col, row)
- * selects the cell (col / cell_size, row / cell_size); pixels right of or below the last full
- * cell select none, and a cell counts once however many of its pixels are listed (cell centres
- * alone or whole cells both work). Without setIndices() every cell counts as static. The set S
+ * and a_i (prev_x, prev_y, prev_z; previous frame); the cell geometry is inferred from it
+ * (FlowGrid::fromFlow()). The static cells come as cells (setStaticCells(): the cells labelled
+ * LABEL_STATIC, e.g. from StaticSetSelection) or, PCL's way, as pixels (setIndices()): a pixel
+ * selects the cell holding it (FlowGrid::cellOfPixel(); pixels right of or below the last full
+ * cell select none), and a cell counts once however many of its pixels are listed. Static cells,
+ * when set, take precedence over indices; with neither, every cell counts as static. The set S
  * holds the selected cells with valid_3d, finite a_i and b_i and weight > 0. The weighted
  * least-squares rigid fit (RigidFitAccumulator, weights = flow weights) maps b_i onto a_i; then
  * trim_rounds rounds keep the cells of S with E_i <= trim_factor * th_inlier and refit; a round
  * leaving fewer than min_correspondences cells, or a degenerate refit, keeps the previous fit.
  *
- * Refinement (optional): ICP or GICP on plain XYZ copies of the static points of the source
- * (every refinement_stride-th row and column) against the finite points of the whole target on
+ * Refinement (optional): ICP or GICP on plain XYZ copies of the finite static source points
+ * (the pixels of the static cells, or else the listed indices; every refinement_stride-th row
+ * and column) against the finite points of the whole target on
  * the same lattice, initialised with the flow estimate. Moving objects in the previous frame are
  * kept out only by refinement_max_correspondence_distance.
  *
@@ -62,8 +65,9 @@ enum class StaticRegistrationStatus {
  * prediction and flag the frame as lost. getFitnessScore() is the mean squared residual E_i (m^2)
  * of the kept cells under the final transformation (also after refinement).
  * getNumberOfCorrespondences() is |S|, getNumberOfInliers() the number of kept cells.
- * The output cloud of align() holds the static points transformed into the previous frame; it is
- * unorganized once indices are set (PCL's registration.hpp) and empty when not converged.
+ * The output cloud of align() holds the source points of setIndices() (all of them without)
+ * transformed into the previous frame; it is unorganized once indices are set (PCL's
+ * registration.hpp) and empty when not converged.
  *
  * pcl::Registration's own knobs (setMaximumIterations, setMaxCorrespondenceDistance, the
  * correspondence estimation and rejectors) are not used: see Parameters. No kd-tree is ever
@@ -74,8 +78,8 @@ enum class StaticRegistrationStatus {
  * dynvo::StaticSceneRegistration<pcl::PointXYZRGB> registration;
  * registration.setInputSource(current);               // frame k
  * registration.setInputTarget(previous);              // frame k-1
- * registration.setIndices(static_indices);            // e.g. segments[0] of the segmentation
  * registration.setInputFlow(flow);                    // grid scene flow k-1 -> k
+ * registration.setStaticCells(static_cells);          // e.g. from StaticSetSelection
  * pcl::PointCloud<pcl::PointXYZRGB> aligned;
  * registration.align(aligned, T_prev_curr_predicted); // the guess is returned when not converged
  * if (registration.hasConverged()) T_world_curr = T_world_prev * registration.getFinalTransformation();
@@ -106,6 +110,14 @@ public:
   void setInputFlow(const FlowCloudConstPtr& flow) { flow_ = flow; }
 
   const FlowCloudConstPtr& getInputFlow() const { return flow_; }
+
+  /** \brief The static set as cells: those labelled LABEL_STATIC. Its geometry must be the
+   * flow's on the source cloud (checked by align()); takes precedence over setIndices(). An
+   * empty grid (FlowGrid()) removes it.
+   */
+  void setStaticCells(const FlowGrid& cells) { static_cells_input_ = cells; }
+
+  const FlowGrid& getStaticCells() const { return static_cells_input_; }
 
   /// Estimates T_prev_curr; see the class doc. \param[out] output static points, moved
   void align(PointCloud& output) { align(output, Matrix4::Identity()); }
@@ -169,8 +181,9 @@ protected:
   void computeTransformation(PointCloud& output, const Matrix4& guess) override;
 
   /// Non-null organized source, target and flow; equal source and target sizes; a flow grid
-  /// matching the cloud (see the class doc); indices in range. Logs PCL_ERROR otherwise.
-  bool validateInputs() const;
+  /// matching the cloud (see the class doc), static cells on the same grid; indices in range.
+  /// Sets grid_; logs PCL_ERROR otherwise.
+  bool validateInputs();
 
   /// Collects S from the indices and the flow (fills source_points_, target_points_, weights_).
   void collectCorrespondences();
@@ -199,7 +212,9 @@ private:
   std::vector<Eigen::Vector3d> target_points_; ///< a_i of S (metres, previous frame)
   std::vector<double> weights_;                ///< flow weight of each cell of S
   std::vector<std::uint8_t> inliers_; ///< 1 for the cells of S kept by the trimming
-  std::vector<std::uint8_t> static_cells_; ///< per grid cell: selected by an index
+  FlowGrid static_cells_input_;       ///< setStaticCells(); empty when not set
+  FlowGrid grid_;                     ///< geometry of the flow on the source cloud
+  std::vector<std::uint8_t> static_cells_; ///< per grid cell: selected
 };
 
 } // namespace dynvo

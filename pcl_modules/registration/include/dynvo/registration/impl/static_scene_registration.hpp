@@ -51,7 +51,7 @@ StaticSceneRegistration<PointT>::align(PointCloud& output, const Matrix4& guess)
 
 template <typename PointT>
 bool
-StaticSceneRegistration<PointT>::validateInputs() const
+StaticSceneRegistration<PointT>::validateInputs()
 {
   const char* name = reg_name_.c_str();
   if (!input_ || !target_ || !flow_) {
@@ -73,11 +73,20 @@ StaticSceneRegistration<PointT>::validateInputs() const
               name, input_->width, input_->height, target_->width, target_->height);
     return false;
   }
-  const std::uint32_t cell = flow_->width > 0 ? input_->width / flow_->width : 0;
-  if (cell == 0 || input_->height / cell != flow_->height) {
+  if (!FlowGrid::fromFlow(*flow_, input_->width, input_->height, grid_)) {
     PCL_ERROR("[dynvo::%s::align] a %ux%u flow grid does not tile a %ux%u cloud "
               "(cell size = width / flow width).\n",
               name, flow_->width, flow_->height, input_->width, input_->height);
+    return false;
+  }
+  if (static_cells_input_.size() > 0 &&
+      (!static_cells_input_.sameGeometry(grid_) ||
+       static_cells_input_.labels.size() != grid_.size())) {
+    PCL_ERROR(
+        "[dynvo::%s::align] the static cells (%ux%u cells of %u px) are not on the "
+        "flow's grid (%ux%u cells of %u px).\n",
+        name, static_cells_input_.cols, static_cells_input_.rows,
+        static_cells_input_.cell_size, grid_.cols, grid_.rows, grid_.cell_size);
     return false;
   }
   if (indices_ && !fake_indices_) {
@@ -97,16 +106,17 @@ template <typename PointT>
 void
 StaticSceneRegistration<PointT>::collectCorrespondences()
 {
-  const std::size_t width = input_->width;
-  const std::size_t grid_width = flow_->width;
-  const std::size_t grid_height = flow_->height;
-  const std::size_t cell = width / grid_width;
-  static_cells_.assign(flow_->size(), 0);
-  for (const auto index : *indices_) {
-    const std::size_t col = static_cast<std::size_t>(index) % width / cell;
-    const std::size_t row = static_cast<std::size_t>(index) / width / cell;
-    if (col < grid_width && row < grid_height)
-      static_cells_[row * grid_width + col] = 1;
+  static_cells_.assign(grid_.size(), 0);
+  if (static_cells_input_.size() > 0) {
+    for (std::size_t i = 0; i < grid_.size(); ++i)
+      static_cells_[i] = static_cells_input_.labels[i] == LABEL_STATIC;
+  }
+  else {
+    for (const auto index : *indices_) {
+      const std::size_t i = grid_.cellOfPixel(static_cast<std::size_t>(index));
+      if (i < grid_.size())
+        static_cells_[i] = 1;
+    }
   }
   for (std::size_t i = 0; i < flow_->size(); ++i) {
     const PointFlow& f = (*flow_)[i];
@@ -177,10 +187,19 @@ StaticSceneRegistration<PointT>::refine(Matrix4& refined) const
     return index % width % stride == 0 && index / width % stride == 0;
   };
   pcl::PointCloud<pcl::PointXYZ>::Ptr source(new pcl::PointCloud<pcl::PointXYZ>);
-  for (const auto index : *indices_) {
+  const auto add_source = [&](std::size_t index) {
     const PointT& p = (*input_)[index];
-    if (on_lattice(static_cast<std::size_t>(index)) && pcl::isXYZFinite(p))
+    if (on_lattice(index) && pcl::isXYZFinite(p))
       source->push_back(pcl::PointXYZ(p.x, p.y, p.z));
+  };
+  if (static_cells_input_.size() > 0) {
+    for (std::size_t i = 0; i < grid_.size(); ++i)
+      if (static_cells_[i])
+        grid_.forEachPixel(i, add_source);
+  }
+  else {
+    for (const auto index : *indices_)
+      add_source(static_cast<std::size_t>(index));
   }
   pcl::PointCloud<pcl::PointXYZ>::Ptr target(new pcl::PointCloud<pcl::PointXYZ>);
   for (std::size_t index = 0; index < target_->size(); ++index) {
