@@ -132,7 +132,7 @@ struct OdometryPipeline::Impl {
     selection.setPredictedMotion(T_curr_prev_predicted);
     result.lost = !selection.align(registration);
     if (!result.lost)
-      noise_tracker.addResidual(registration.getFitnessScore());
+      noise_tracker.addResidual(registration.getMeanSquaredResidual());
     result.T_curr_prev =
         result.lost
             ? T_curr_prev_predicted

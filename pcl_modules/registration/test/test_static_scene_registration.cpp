@@ -60,7 +60,7 @@ TYPED_TEST(StaticSceneRegistrationTyped, SameFrameTwiceGivesIdentity)
   EXPECT_EQ(registration.getNumberOfCorrespondences(), pair.staticCellCount());
   EXPECT_EQ(registration.getNumberOfInliers(), pair.staticCellCount());
   // Residuals are float round-off only: (1e-5 m)^2 bounds it with a wide margin.
-  EXPECT_LT(registration.getFitnessScore(), 1e-10);
+  EXPECT_LT(registration.getMeanSquaredResidual(), 1e-10);
   // align() returns the static points, unorganized (PCL's rule once indices are set).
   EXPECT_EQ(aligned.size(), pair.staticPixels()->indices.size());
   EXPECT_EQ(aligned.height, 1u);
@@ -91,7 +91,7 @@ TYPED_TEST(StaticSceneRegistrationTyped, RecoversAKnownMotionForwardAndInverse)
     // The moving box's cells were never selected, so nothing was trimmed.
     EXPECT_EQ(registration.getNumberOfInliers(), pair.staticCellCount());
     // Exact correspondences: the mean squared residual is round-off, below (10 um)^2.
-    EXPECT_LT(registration.getFitnessScore(), 1e-10) << "inverse " << inverse;
+    EXPECT_LT(registration.getMeanSquaredResidual(), 1e-10) << "inverse " << inverse;
   }
 }
 
@@ -121,7 +121,7 @@ TYPED_TEST(StaticSceneRegistrationTyped, TooFewStaticCellsDoNotConverge)
             StaticRegistrationStatus::too_few_correspondences);
   EXPECT_EQ(registration.getNumberOfCorrespondences(), 5u);
   EXPECT_EQ(registration.getFinalTransformation(), prediction);
-  EXPECT_EQ(registration.getFitnessScore(), std::numeric_limits<double>::max());
+  EXPECT_EQ(registration.getMeanSquaredResidual(), std::numeric_limits<double>::max());
   EXPECT_TRUE(aligned.empty());
   // Lowering the minimum to 5 turns the same input into a converged estimate.
   registration.setMinCorrespondences(5);
@@ -190,8 +190,8 @@ TEST_F(StaticSceneRegistrationTest, StaticCellsSelectWhatTheirPixelsSelect)
   EXPECT_EQ(registration_.getNumberOfCorrespondences(), pair_.staticCellCount());
   // The same cells in the same order: the same fit, bit for bit.
   EXPECT_EQ(registration_.getFinalTransformation(), by_pixels);
-  // The output is PCL's: the indexed source points, moved.
-  EXPECT_EQ(aligned_.size(), 1u);
+  // The output: the centres of the static cells, moved.
+  EXPECT_EQ(aligned_.size(), pair_.staticCellCount());
 
   registration_.setStaticCells(dynvo::FlowGrid());
   registration_.align(aligned_);
@@ -249,7 +249,7 @@ TEST_F(StaticSceneRegistrationTest, OutliersInTheStaticSetAreTrimmed)
             TRANSLATION_TOL);
   EXPECT_EQ(registration_.getNumberOfInliers(), pair_.staticCellCount() - 5);
   // The kept cells are exact, so the fitness is round-off, below (10 um)^2.
-  EXPECT_LT(registration_.getFitnessScore(), 1e-10);
+  EXPECT_LT(registration_.getMeanSquaredResidual(), 1e-10);
 }
 
 TEST_F(StaticSceneRegistrationTest, CollinearStaticCellsAreDegenerate)
@@ -329,13 +329,14 @@ TEST_F(StaticSceneRegistrationTest, MissingInputsAreLoggedAndNotConverged)
   registration_.align(aligned_);
   ASSERT_TRUE(registration_.hasConverged()); // a good run first: nothing may stay stale
 
+  // No source or target: pcl::Registration::align() reports it and computes nothing.
   dynvo::StaticSceneRegistration<Point> empty;
   ::testing::internal::CaptureStderr();
   empty.align(aligned_);
-  EXPECT_NE(::testing::internal::GetCapturedStderr().find(PREFIX), std::string::npos);
+  EXPECT_NE(::testing::internal::GetCapturedStderr().find("StaticSceneRegistration"),
+            std::string::npos);
   EXPECT_FALSE(empty.hasConverged());
-  EXPECT_EQ(empty.getStatus(), StaticRegistrationStatus::invalid_input);
-  EXPECT_TRUE(aligned_.empty());
+  EXPECT_EQ(empty.getStatus(), StaticRegistrationStatus::not_computed);
 
   registration_.setInputFlow(nullptr);
   const std::string log = alignCapturingErrors();
@@ -355,7 +356,8 @@ TEST_F(StaticSceneRegistrationTest, MissingInputsAreLoggedAndNotConverged)
   ::testing::internal::CaptureStderr();
   no_target.align(aligned_);
   const std::string target_log = ::testing::internal::GetCapturedStderr();
-  EXPECT_NE(target_log.find(PREFIX), std::string::npos) << target_log;
+  EXPECT_NE(target_log.find("StaticSceneRegistration"), std::string::npos)
+      << target_log;
   EXPECT_NE(target_log.find("target"), std::string::npos) << target_log;
   EXPECT_FALSE(no_target.hasConverged());
 }
@@ -397,15 +399,82 @@ TEST_F(StaticSceneRegistrationTest, MismatchedSizesAndBadIndicesAreRejected)
   EXPECT_NE(alignCapturingErrors().find(PREFIX), std::string::npos);
   EXPECT_FALSE(registration_.hasConverged());
 
+  // Bad indices are rejected when set, before pcl::Registration::align() could copy them,
+  // and reported again by align().
   registration_.setInputFlow(pair_.flow);
   pcl::PointIndices::Ptr bad(new pcl::PointIndices);
   bad->indices = {0, static_cast<int>(pair_.current.cloud->size())};
+  ::testing::internal::CaptureStderr();
   registration_.setIndices(bad);
+  EXPECT_NE(::testing::internal::GetCapturedStderr().find(
+                "[dynvo::StaticSceneRegistration::setIndices]"),
+            std::string::npos);
   EXPECT_NE(alignCapturingErrors().find(PREFIX), std::string::npos);
   EXPECT_FALSE(registration_.hasConverged());
+  EXPECT_EQ(registration_.getStatus(), StaticRegistrationStatus::invalid_input);
   bad->indices = {-1};
+  ::testing::internal::CaptureStderr();
+  registration_.setIndices(bad);
+  ::testing::internal::GetCapturedStderr();
   EXPECT_NE(alignCapturingErrors().find(PREFIX), std::string::npos);
   EXPECT_FALSE(registration_.hasConverged());
+  // Rejected indices select nothing; the source they were meant for takes them back.
+  EXPECT_TRUE(registration_.getIndices()->empty());
+  bad->indices = {0, static_cast<int>(pair_.current.cloud->size())};
+  ::testing::internal::CaptureStderr();
+  registration_.setIndices(bad);
+  ::testing::internal::GetCapturedStderr();
+  registration_.setInputSource(BoxScene::make(320, 240).render<Point>(true).cloud);
+  EXPECT_EQ(registration_.getIndices()->size(), 2u);
+}
+
+TEST(StaticSceneRegistrationAsPcl, WorksThroughAPclRegistrationPointer)
+{
+  // Everything but the flow goes through pcl::Registration: inputs, indices, knobs, align()
+  // and PCL's fitness score.
+  const BoxScene scene = BoxScene::make();
+  const FramePair<Point> pair(scene);
+  auto registration = pcl::make_shared<dynvo::StaticSceneRegistration<Point>>();
+  registration->setInputFlow(pair.flow);
+  pcl::Registration<Point, Point, float>* base = registration.get();
+  base->setInputSource(pair.current.cloud);
+  base->setInputTarget(pair.previous.cloud);
+  base->setIndices(pair.staticPixels());
+  base->setMaximumIterations(12);
+  base->setMaxCorrespondenceDistance(0.02);
+  base->setTransformationEpsilon(1e-9);
+  // The base's knobs are the refinement's.
+  const dynvo::StaticSceneRegistrationParameters parameters =
+      registration->getParameters();
+  EXPECT_EQ(parameters.refinement_max_iterations, 12);
+  EXPECT_EQ(parameters.refinement_max_correspondence_distance, 0.02);
+  EXPECT_EQ(parameters.refinement_transformation_epsilon, 1e-9);
+  dynvo::StaticSceneRegistrationParameters defaults;
+  registration->setParameters(defaults);
+  EXPECT_EQ(base->getMaximumIterations(), defaults.refinement_max_iterations);
+  EXPECT_EQ(base->getMaxCorrespondenceDistance(),
+            defaults.refinement_max_correspondence_distance);
+  EXPECT_EQ(base->getTransformationEpsilon(),
+            defaults.refinement_transformation_epsilon);
+
+  pcl::PointCloud<Point> aligned;
+  base->align(aligned);
+  ASSERT_TRUE(base->hasConverged());
+  const Eigen::Matrix4d truth = scene.T_curr_prev.inverse().matrix();
+  EXPECT_LT(translationError(base->getFinalTransformation(), truth), TRANSLATION_TOL);
+  EXPECT_LT(rotationError(base->getFinalTransformation(), truth), ROTATION_TOL);
+  EXPECT_EQ(aligned.size(), pair.staticPixels()->indices.size());
+  // PCL's fitness: nearest target points of the moved source. The exact static points land
+  // on the same surfaces, between target samples at most a pixel apart (<= 3 cm at 3.5 m and
+  // 160x120), so the mean squared distance stays below (3 cm)^2; the moving box's points,
+  // 13 cm away from where they were, are left out by a 5 cm max_range.
+  const double fitness = base->getFitnessScore(0.05 * 0.05);
+  EXPECT_GT(fitness, 0.0);
+  EXPECT_LT(fitness, 0.03 * 0.03);
+
+  // Knobs set through the base are checked when used.
+  base->setMaximumIterations(0);
+  EXPECT_THROW(base->align(aligned), std::invalid_argument);
 }
 
 TEST_F(StaticSceneRegistrationTest, CallsThroughThePclBaseAreCheckedToo)
@@ -441,11 +510,15 @@ TEST(StaticSceneRegistrationParameters, DefaultsFollowTheAlgorithmAndBadValuesTh
   EXPECT_THROW(
       registration.setRefinement(static_cast<dynvo::RegistrationRefinement>(7)),
       std::invalid_argument);
-  EXPECT_THROW(registration.setRefinementMaxCorrespondenceDistance(0.0),
-               std::invalid_argument);
-  EXPECT_THROW(registration.setRefinementMaxIterations(0), std::invalid_argument);
-  EXPECT_THROW(registration.setRefinementTransformationEpsilon(-1.0),
-               std::invalid_argument);
+  dynvo::StaticSceneRegistrationParameters bad;
+  bad.refinement_max_correspondence_distance = 0.0;
+  EXPECT_THROW(registration.setParameters(bad), std::invalid_argument);
+  bad = defaults;
+  bad.refinement_max_iterations = 0;
+  EXPECT_THROW(registration.setParameters(bad), std::invalid_argument);
+  bad = defaults;
+  bad.refinement_transformation_epsilon = -1.0;
+  EXPECT_THROW(registration.setParameters(bad), std::invalid_argument);
   EXPECT_THROW(registration.setRefinementStride(0), std::invalid_argument);
   // A rejected value leaves the previous one in place.
   EXPECT_FLOAT_EQ(registration.getInlierThreshold(), 3e-5f);

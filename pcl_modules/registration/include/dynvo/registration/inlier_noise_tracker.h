@@ -31,7 +31,7 @@ struct DYNVO_EXPORTS InlierNoiseTrackerParameters {
  * (docs/algorithm.md §7).
  *
  * After every converged static fit, addResidual() takes its mean squared residual E
- * (StaticSceneRegistration::getFitnessScore()) into a running mean, weight RESIDUAL_WEIGHT per
+ * (StaticSceneRegistration::getMeanSquaredResidual()) into a running mean, weight RESIDUAL_WEIGHT per
  * frame (the first residual starts it). getInlierThreshold() is inlier_noise_factor times that
  * mean, clamped to [min_inlier_threshold, upper bound]; before the first residual, or with
  * inlier_noise_factor 0, it is the upper bound (setUpperBound(), the segmentation's configured
@@ -41,7 +41,7 @@ struct DYNVO_EXPORTS InlierNoiseTrackerParameters {
  * tracker.setUpperBound(6e-5);                                  // m^2
  * segmentation.setInlierThreshold(static_cast<float>(tracker.getInlierThreshold()));
  * ...                                                           // segment, register
- * if (registration.hasConverged()) tracker.addResidual(registration.getFitnessScore());
+ * if (registration.hasConverged()) tracker.addResidual(registration.getMeanSquaredResidual());
  * \endcode
  */
 class DYNVO_EXPORTS InlierNoiseTracker {

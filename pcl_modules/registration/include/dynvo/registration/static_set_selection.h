@@ -37,7 +37,7 @@ namespace dynvo {
  *
  * The registration's source, target and flow are set by the caller; align() sets its static
  * cells and leaves the last fit in it (hasConverged(), getFinalTransformation() =
- * T_prev_curr, getFitnessScore()).
+ * T_prev_curr, getMeanSquaredResidual()).
  * \code
  * dynvo::StaticSetSelection<pcl::PointXYZRGB> selection;
  * registration.setInputSource(current);

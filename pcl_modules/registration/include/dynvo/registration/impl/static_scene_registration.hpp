@@ -16,8 +16,123 @@ namespace dynvo {
 template <typename PointT> StaticSceneRegistration<PointT>::StaticSceneRegistration()
 {
   reg_name_ = "StaticSceneRegistration";
-  // The flow gives the correspondences: never build the base class's kd-tree on the target.
-  Base::setSearchMethodTarget(Base::getSearchMethodTarget(), true);
+  // The flow gives the correspondences: the target's kd-tree is only built when the base
+  // class's getFitnessScore(max_range) asks for it.
+  Base::setSearchMethodTarget(pcl::make_shared<detail::LazyKdTree<PointT>>());
+  setParameters(Parameters());
+}
+
+template <typename PointT>
+void
+StaticSceneRegistration<PointT>::setParameters(const Parameters& parameters)
+{
+  parameters.validate();
+  assignParameters(parameters);
+  max_iterations_ = parameters.refinement_max_iterations;
+  corr_dist_threshold_ = parameters.refinement_max_correspondence_distance;
+  transformation_epsilon_ = parameters.refinement_transformation_epsilon;
+}
+
+template <typename PointT>
+typename StaticSceneRegistration<PointT>::Parameters
+StaticSceneRegistration<PointT>::getParameters() const
+{
+  Parameters parameters = params_;
+  parameters.refinement_max_iterations = max_iterations_;
+  parameters.refinement_max_correspondence_distance = corr_dist_threshold_;
+  parameters.refinement_transformation_epsilon = transformation_epsilon_;
+  return parameters;
+}
+
+template <typename PointT>
+void
+StaticSceneRegistration<PointT>::setIndices(const pcl::IndicesPtr& indices)
+{
+  Base::setIndices(indices);
+  user_indices_ = indices_;
+  updateIndices();
+}
+
+template <typename PointT>
+void
+StaticSceneRegistration<PointT>::setIndices(const pcl::IndicesConstPtr& indices)
+{
+  Base::setIndices(indices);
+  user_indices_ = indices_;
+  updateIndices();
+}
+
+template <typename PointT>
+void
+StaticSceneRegistration<PointT>::setIndices(const pcl::PointIndicesConstPtr& indices)
+{
+  Base::setIndices(indices);
+  user_indices_ = indices_;
+  updateIndices();
+}
+
+template <typename PointT>
+void
+StaticSceneRegistration<PointT>::setIndices(std::size_t row_start,
+                                            std::size_t col_start,
+                                            std::size_t nb_rows,
+                                            std::size_t nb_cols)
+{
+  Base::setIndices(row_start, col_start, nb_rows, nb_cols);
+  user_indices_ = indices_;
+  updateIndices();
+}
+
+template <typename PointT>
+void
+StaticSceneRegistration<PointT>::setStaticCells(const FlowGrid& cells)
+{
+  static_cells_input_ = cells;
+  updateIndices();
+}
+
+template <typename PointT>
+void
+StaticSceneRegistration<PointT>::setInputSource(const PointCloudConstPtr& cloud)
+{
+  Base::setInputSource(cloud);
+  updateIndices();
+}
+
+template <typename PointT>
+void
+StaticSceneRegistration<PointT>::updateIndices()
+{
+  indices_rejected_ = false;
+  if (static_cells_input_.size() > 0) {
+    // The centres of the static cells: a small output, and in range whenever the cells are
+    // on the source's grid (otherwise validateInputs() rejects them).
+    auto centres = pcl::make_shared<pcl::Indices>();
+    if (input_ && static_cells_input_.image_width == input_->width &&
+        static_cells_input_.image_height == input_->height)
+      for (std::size_t i = 0; i < static_cells_input_.size(); ++i)
+        if (static_cells_input_.labels[i] == LABEL_STATIC)
+          centres->push_back(
+              static_cast<pcl::index_t>(static_cells_input_.centreIndex(i)));
+    indices_ = centres;
+    fake_indices_ = false;
+    return;
+  }
+  indices_ = user_indices_;
+  fake_indices_ = false;
+  if (!user_indices_ || !input_)
+    return;
+  for (const auto index : *user_indices_) {
+    if (index < 0 || static_cast<std::size_t>(index) >= input_->size()) {
+      indices_rejected_ = true;
+      rejected_index_ = static_cast<int>(index);
+      PCL_ERROR(
+          "[dynvo::%s::setIndices] index %d is outside the %zu-point source cloud.\n",
+          reg_name_.c_str(), rejected_index_, input_->size());
+      indices_ = pcl::make_shared<pcl::Indices>();
+      return;
+    }
+  }
 }
 
 template <typename PointT>
@@ -29,24 +144,12 @@ StaticSceneRegistration<PointT>::resetResults(const Matrix4& guess)
   transformation_ = guess;
   flow_transformation_ = guess;
   status_ = Status::invalid_input;
-  fitness_ = std::numeric_limits<double>::max();
+  mean_squared_residual_ = std::numeric_limits<double>::max();
   inlier_count_ = 0;
   source_points_.clear();
   target_points_.clear();
   weights_.clear();
   inliers_.clear();
-}
-
-template <typename PointT>
-void
-StaticSceneRegistration<PointT>::align(PointCloud& output, const Matrix4& guess)
-{
-  output.clear();
-  resetResults(guess);
-  // Checked before the base class copies the indexed points, which it does unchecked.
-  if (!validateInputs())
-    return;
-  Base::align(output, guess);
 }
 
 template <typename PointT>
@@ -89,15 +192,10 @@ StaticSceneRegistration<PointT>::validateInputs()
         static_cells_input_.cell_size, grid_.cols, grid_.rows, grid_.cell_size);
     return false;
   }
-  if (indices_ && !fake_indices_) {
-    for (const auto index : *indices_) {
-      if (index < 0 || static_cast<std::size_t>(index) >= input_->size()) {
-        PCL_ERROR(
-            "[dynvo::%s::align] index %d is outside the %zu-point source cloud.\n",
-            name, static_cast<int>(index), input_->size());
-        return false;
-      }
-    }
+  if (indices_rejected_) {
+    PCL_ERROR("[dynvo::%s::align] index %d is outside the %zu-point source cloud.\n",
+              name, rejected_index_, input_->size());
+    return false;
   }
   return true;
 }
@@ -179,9 +277,10 @@ StaticSceneRegistration<PointT>::estimateFromFlow()
 
 template <typename PointT>
 bool
-StaticSceneRegistration<PointT>::refine(Matrix4& refined) const
+StaticSceneRegistration<PointT>::refine(const Parameters& parameters,
+                                        Matrix4& refined) const
 {
-  const std::size_t stride = static_cast<std::size_t>(params_.refinement_stride);
+  const std::size_t stride = static_cast<std::size_t>(parameters.refinement_stride);
   const std::size_t width = input_->width;
   const auto on_lattice = [stride, width](std::size_t index) {
     return index % width % stride == 0 && index / width % stride == 0;
@@ -214,8 +313,8 @@ StaticSceneRegistration<PointT>::refine(Matrix4& refined) const
               reg_name_.c_str(), source->size(), target->size());
     return false;
   }
-  return detail::refineRigidTransformation(source, target, params_.refinement, params_,
-                                           flow_transformation_, refined);
+  return detail::refineRigidTransformation(source, target, parameters.refinement,
+                                           parameters, flow_transformation_, refined);
 }
 
 template <typename PointT>
@@ -223,8 +322,10 @@ void
 StaticSceneRegistration<PointT>::computeTransformation(PointCloud& output,
                                                        const Matrix4& guess)
 {
+  const Parameters parameters = getParameters();
+  // The per-field setters and pcl::Registration's do not check what ties the fields.
+  parameters.validate();
   resetResults(guess);
-  // Repeated here for calls through a pcl::Registration reference, which bypass align().
   if (!validateInputs()) {
     output.clear();
     return;
@@ -239,7 +340,7 @@ StaticSceneRegistration<PointT>::computeTransformation(PointCloud& output,
   final_transformation_ = flow_transformation_;
   if (params_.refinement != Refinement::none) {
     Matrix4 refined;
-    if (refine(refined))
+    if (refine(parameters, refined))
       final_transformation_ = refined;
     else
       status_ = Status::refinement_not_converged;
@@ -251,7 +352,7 @@ StaticSceneRegistration<PointT>::computeTransformation(PointCloud& output,
     if (inliers_[i])
       residual_sum +=
           squaredTransferError(T_final, source_points_[i], target_points_[i]);
-  fitness_ = residual_sum / static_cast<double>(inlier_count_);
+  mean_squared_residual_ = residual_sum / static_cast<double>(inlier_count_);
   pcl::transformPointCloud(output, output, final_transformation_);
 }
 
