@@ -11,12 +11,11 @@ const ParameterTable<InlierNoiseTrackerParameters>&
 InlierNoiseTrackerParameters::table()
 {
   using P = InlierNoiseTrackerParameters;
-  using R = FieldRange;
   static_assert(AGGREGATE_FIELD_COUNT<P> == 2, "every field of P needs a row below");
   static const ParameterTable<P> table(std::vector<ParameterTable<P>::Field>{
-      makeField("inlier_noise_factor", &P::inlier_noise_factor, R::atLeast(0),
+      makeField("inlier_noise_factor", &P::inlier_noise_factor, FieldRange::atLeast(0),
                 "x mean static residual, 0 = off"),
-      makeField("min_inlier_threshold", &P::min_inlier_threshold, R::above(0),
+      makeField("min_inlier_threshold", &P::min_inlier_threshold, FieldRange::above(0),
                 "m^2, <= segmentation.inlier_threshold"),
   });
   return table;

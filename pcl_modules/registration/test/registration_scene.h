@@ -23,6 +23,14 @@ namespace dynvo::test {
 
 constexpr std::uint32_t CELL = 16; ///< w_grid (px), docs/algorithm.md §0
 
+// The ideal flow holds float copies of exact points at <= 4 m: round-off is ~2e-7 m per
+// coordinate, so a fit on static cells only is exact within 1 mm and 0.05 degrees with a
+// margin of three orders of magnitude, while any systematic error fails: a swapped direction
+// (2 degrees / 3.7 cm in BoxScene::make()), an untrimmed outlier bias (> 1 mm) or a moving
+// cell in the set (the box moves by 13 cm and 10 degrees).
+constexpr double TRANSLATION_TOL = 1e-3;       ///< metres
+constexpr double ROTATION_TOL = radians(0.05); ///< radians
+
 /** \brief Boxes, a known camera motion and one independently moving box. The world frame is
  * the previous camera frame; the current camera sits at T_curr_prev^-1 and the moving boxes
  * are moved by object_motion (world frame).
@@ -123,6 +131,14 @@ template <typename PointT> struct FramePair {
       , grid(scene.width, scene.height, CELL)
   {
     flow.reset(new pcl::PointCloud<PointFlow>(scene.flow(current, static_cells)));
+  }
+
+  /// Sets a registration's source (current), target (previous) and flow.
+  template <typename Registration> void feed(Registration& registration) const
+  {
+    registration.setInputSource(current.cloud);
+    registration.setInputTarget(previous.cloud);
+    registration.setInputFlow(flow);
   }
 
   /// The cells flagged in mask, labelled LABEL_STATIC on the flow's grid.

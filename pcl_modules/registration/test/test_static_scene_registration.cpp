@@ -17,19 +17,7 @@
 namespace {
 
 using dynvo::StaticRegistrationStatus;
-using dynvo::test::BoxScene;
-using dynvo::test::CELL;
-using dynvo::test::FramePair;
-using dynvo::test::radians;
-using dynvo::test::rotationError;
-using dynvo::test::translationError;
-
-// Noise-free correspondences are float copies of exact points at <= 4 m: round-off is
-// ~2e-7 m per coordinate, so 1 mm and 0.05 degrees (the brief's accuracy) leave a margin of
-// three orders of magnitude while still failing on any systematic error such as a swapped
-// direction (2 degrees / 3.7 cm here) or an untrimmed outlier bias (> 1 mm, checked below).
-constexpr double TRANSLATION_TOL = 1e-3; // metres
-constexpr double ROTATION_TOL = radians(0.05);
+using namespace dynvo::test;
 
 template <typename PointT> class StaticSceneRegistrationTyped : public ::testing::Test {
 };
@@ -74,10 +62,8 @@ TYPED_TEST(StaticSceneRegistrationTyped, RecoversAKnownMotionForwardAndInverse)
       scene.T_curr_prev = scene.T_curr_prev.inverse();
     const FramePair<TypeParam> pair(scene);
     dynvo::StaticSceneRegistration<TypeParam> registration;
-    registration.setInputSource(pair.current.cloud);
-    registration.setInputTarget(pair.previous.cloud);
+    pair.feed(registration);
     registration.setIndices(pair.staticPixels());
-    registration.setInputFlow(pair.flow);
     pcl::PointCloud<TypeParam> aligned;
     registration.align(aligned);
     ASSERT_TRUE(registration.hasConverged()) << "inverse " << inverse;
@@ -108,10 +94,8 @@ TYPED_TEST(StaticSceneRegistrationTyped, TooFewStaticCellsDoNotConverge)
       ++kept;
     }
   dynvo::StaticSceneRegistration<TypeParam> registration;
-  registration.setInputSource(pair.current.cloud);
-  registration.setInputTarget(pair.previous.cloud);
+  pair.feed(registration);
   registration.setIndices(pair.pixels(few));
-  registration.setInputFlow(pair.flow);
   Eigen::Matrix4f prediction = Eigen::Matrix4f::Identity();
   prediction(0, 3) = 0.25f;
   pcl::PointCloud<TypeParam> aligned;
@@ -137,10 +121,8 @@ protected:
       : scene_(BoxScene::make())
       , pair_(scene_)
   {
-    registration_.setInputSource(pair_.current.cloud);
-    registration_.setInputTarget(pair_.previous.cloud);
+    pair_.feed(registration_);
     registration_.setIndices(pair_.staticPixels());
-    registration_.setInputFlow(pair_.flow);
   }
 
   Eigen::Matrix4d truth() const { return scene_.T_curr_prev.inverse().matrix(); }
@@ -540,10 +522,8 @@ TEST(StaticSceneRegistrationVga, VgaFramesWorkAndAMismatchedGridIsRejected)
   EXPECT_EQ(pair.flow->width, 40u);
   EXPECT_EQ(pair.flow->height, 30u);
   dynvo::StaticSceneRegistration<pcl::PointXYZRGBA> registration;
-  registration.setInputSource(pair.current.cloud);
-  registration.setInputTarget(pair.previous.cloud);
+  pair.feed(registration);
   registration.setIndices(pair.staticPixels());
-  registration.setInputFlow(pair.flow);
   pcl::PointCloud<pcl::PointXYZRGBA> aligned;
   registration.align(aligned);
   ASSERT_TRUE(registration.hasConverged());

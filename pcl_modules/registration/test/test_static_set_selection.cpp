@@ -18,17 +18,8 @@ namespace {
 using dynvo::FlowGrid;
 using dynvo::LABEL_NONE;
 using dynvo::LABEL_STATIC;
-using dynvo::test::BoxScene;
-using dynvo::test::FramePair;
-using dynvo::test::radians;
-using dynvo::test::rotationError;
-using dynvo::test::translationError;
+using namespace dynvo::test;
 
-// The flow is ideal (float copies of exact points), so a fit on static cells only is exact
-// up to round-off: 1 mm and 0.05 degrees fail on any moving cell in the set (the box moves
-// by 13 cm and 10 degrees) with a margin of three orders of magnitude.
-constexpr double TRANSLATION_TOL = 1e-3; // metres
-const double ROTATION_TOL = radians(0.05);
 constexpr std::uint8_t LABEL_OBJECT = 2;
 
 std::size_t
@@ -44,9 +35,7 @@ protected:
       : scene_(BoxScene::make())
       , pair_(scene_)
   {
-    registration_.setInputSource(pair_.current.cloud);
-    registration_.setInputTarget(pair_.previous.cloud);
-    registration_.setInputFlow(pair_.flow);
+    pair_.feed(registration_);
     selection_.setInlierThreshold(3e-5);
     selection_.setMotionGuardTolerance(0.03);
     // H_pred = the true motion: a constant-velocity camera.
@@ -108,9 +97,7 @@ TYPED_TEST(StaticSetSelectionTest, KnownMotionForwardAndInverse)
       scene.T_curr_prev = scene.T_curr_prev.inverse();
     this->scene_ = scene;
     this->pair_ = FramePair<TypeParam>(scene);
-    this->registration_.setInputSource(this->pair_.current.cloud);
-    this->registration_.setInputTarget(this->pair_.previous.cloud);
-    this->registration_.setInputFlow(this->pair_.flow);
+    this->pair_.feed(this->registration_);
     this->selection_.setPredictedMotion(scene.T_curr_prev.matrix());
     this->selection_.setCellLabels(this->trueLabels());
     ASSERT_TRUE(this->selection_.align(this->registration_)) << inverse;

@@ -120,20 +120,30 @@ public:
 
   using Base::setIndices;
 
-  /// Static pixels (PCL's way, see the class doc); range-checked against the source.
-  void setIndices(const pcl::IndicesPtr& indices) override;
-
-  /// Static pixels (PCL's way, see the class doc); range-checked against the source.
-  void setIndices(const pcl::IndicesConstPtr& indices) override;
-
-  /// Static pixels (PCL's way, see the class doc); range-checked against the source.
-  void setIndices(const pcl::PointIndicesConstPtr& indices) override;
-
-  /// Static pixels: a block of the organized source (PCL's checks apply).
+  // Static pixels, PCL's way (see the class doc), range-checked against the source.
+  void setIndices(const pcl::IndicesPtr& indices) override
+  {
+    Base::setIndices(indices);
+    adoptIndices();
+  }
+  void setIndices(const pcl::IndicesConstPtr& indices) override
+  {
+    Base::setIndices(indices);
+    adoptIndices();
+  }
+  void setIndices(const pcl::PointIndicesConstPtr& indices) override
+  {
+    Base::setIndices(indices);
+    adoptIndices();
+  }
   void setIndices(std::size_t row_start,
                   std::size_t col_start,
                   std::size_t nb_rows,
-                  std::size_t nb_cols) override;
+                  std::size_t nb_cols) override
+  {
+    Base::setIndices(row_start, col_start, nb_rows, nb_cols);
+    adoptIndices();
+  }
 
   /// Frame k (organized, metres); the indices are range-checked against it.
   void setInputSource(const PointCloudConstPtr& cloud) override;
@@ -208,6 +218,9 @@ protected:
   /// matching the cloud (see the class doc), static cells on the same grid; indices in range.
   /// Sets grid_; logs PCL_ERROR otherwise.
   bool validateInputs();
+
+  /// Keeps the indices the base class just stored as the user's, then updateIndices().
+  void adoptIndices();
 
   /// The indices pcl::Registration::align() copies: the centres of the static cells when
   /// they are set, else the indices given last, range-checked against the source (rejected

@@ -46,39 +46,8 @@ StaticSceneRegistration<PointT>::getParameters() const
 
 template <typename PointT>
 void
-StaticSceneRegistration<PointT>::setIndices(const pcl::IndicesPtr& indices)
+StaticSceneRegistration<PointT>::adoptIndices()
 {
-  Base::setIndices(indices);
-  user_indices_ = indices_;
-  updateIndices();
-}
-
-template <typename PointT>
-void
-StaticSceneRegistration<PointT>::setIndices(const pcl::IndicesConstPtr& indices)
-{
-  Base::setIndices(indices);
-  user_indices_ = indices_;
-  updateIndices();
-}
-
-template <typename PointT>
-void
-StaticSceneRegistration<PointT>::setIndices(const pcl::PointIndicesConstPtr& indices)
-{
-  Base::setIndices(indices);
-  user_indices_ = indices_;
-  updateIndices();
-}
-
-template <typename PointT>
-void
-StaticSceneRegistration<PointT>::setIndices(std::size_t row_start,
-                                            std::size_t col_start,
-                                            std::size_t nb_rows,
-                                            std::size_t nb_cols)
-{
-  Base::setIndices(row_start, col_start, nb_rows, nb_cols);
   user_indices_ = indices_;
   updateIndices();
 }
