@@ -72,8 +72,9 @@ struct FrameResult {
       Eigen::Matrix4d::Identity(); ///< camera pose (camera-to-world)
   Eigen::Matrix4d T_curr_prev =
       Eigen::Matrix4d::Identity(); ///< ego-motion H_k (identity at frame 0)
-  bool lost =
-      false; ///< too few static cells: T_curr_prev is the constant-velocity prediction
+  /// no ego-motion (too few static cells, or a bad frame: see error); T_curr_prev is then
+  /// the constant-velocity prediction
+  bool lost = false;
   /// segments[0] = static background pixels, then moving objects (pcl::PointIndices each)
   std::vector<pcl::PointIndices> segments;
   std::vector<std::uint8_t> segment_labels; ///< label id of each segment (1 = static)
