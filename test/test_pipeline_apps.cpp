@@ -106,7 +106,7 @@ TEST_F(PipelineApps, SegmentWritesTheLabelsOfOdometryWithFlagsAndConfig)
   // Every shared kind of flag, and a file that moves the pipeline off its defaults.
   dynvo::app::PipelineOptions changed;
   changed.segmentation.inlier_threshold = 4e-5f;
-  changed.inlier_noise_factor = 0.0f;
+  changed.inlier_noise.inlier_noise_factor = 0.0f;
   dynvo::app::writePipelineConfig(dir_.file("c.yaml"), changed);
   expectSameLabels("-config " + dir_.file("c.yaml") +
                    " -seed 7 -threads 2 -no_tracking -refine icp -max_frames 12");
@@ -116,7 +116,7 @@ TEST_F(PipelineApps, ConfigMeansTheSameInEveryApp)
 {
   // A grid of 8 px cells instead of 16: dynvo_scene_flow's PCD has 20x15 cells.
   dynvo::app::PipelineOptions changed;
-  changed.scene_flow.cell_size = changed.segmentation.cell_size = 8;
+  changed.scene_flow.cell_size = 8;
   dynvo::app::writePipelineConfig(dir_.file("c.yaml"), changed);
   const std::string config = " -config " + dir_.file("c.yaml");
   const auto flow = runCommand(SCENE_FLOW + source() + config + " -frame 3 -out " +
@@ -200,7 +200,6 @@ TEST(PipelineFlags, EachFlagSetsItsKeysAndNothingElse)
                                 "-refine", "gicp", "-camera", "fr1"});
   EXPECT_EQ(given.threads, 4u);
   EXPECT_EQ(given.scene_flow.cell_size, 8);
-  EXPECT_EQ(given.segmentation.cell_size, 8); // the two grids must agree
   EXPECT_EQ(given.scene_flow.window_size, 15);
   EXPECT_EQ(given.scene_flow.max_pyramid_level, 2);
   EXPECT_EQ(given.scene_flow.forward_backward_check,

@@ -13,12 +13,12 @@ namespace dynvo::app {
 
 namespace {
 
-/// A flag that sets configuration keys (pipelineConfigTable()) to the value given.
+/// A flag that sets a configuration key (pipelineConfigTable()) to the value given.
 struct ParameterFlag {
   std::string name; ///< without the dash
-  /// keys set to the same value; the first gives kind, range and default (a boolean key
-  /// makes the flag a switch that sets the keys to 0)
-  std::vector<std::string> keys;
+  /// the key; it gives kind, range and default (a boolean key makes the flag a switch that
+  /// sets the key to 0)
+  std::string key;
   std::string value_name; ///< e.g. "PX"; "" for a choice (its names) or a switch
   std::string help;       ///< what it sets; the default and the keys are added
   PipelineStages stages;  ///< the widest part of the pipeline that has it
@@ -31,43 +31,43 @@ parameterFlags()
   using S = PipelineStages;
   static const std::vector<ParameterFlag> flags{
       {"threads",
-       {"pipeline.threads"},
+       "pipeline.threads",
        "N",
        "worker threads; results do not depend on it",
        S::scene_flow},
       {"cell_size",
-       {"scene_flow.cell_size", "segmentation.cell_size"},
+       "scene_flow.cell_size",
        "PX",
        "grid cell size",
        S::scene_flow},
       {"window_size",
-       {"scene_flow.window_size"},
+       "scene_flow.window_size",
        "PX",
        "LK window side",
        S::scene_flow},
       {"max_pyramid_level",
-       {"scene_flow.max_pyramid_level"},
+       "scene_flow.max_pyramid_level",
        "L",
        "LK pyramid levels above the image",
        S::scene_flow},
       {"fb_check",
-       {"scene_flow.forward_backward_check"},
+       "scene_flow.forward_backward_check",
        "",
        "forward-backward scheme",
        S::scene_flow},
-      {"seed", {"segmentation.seed"}, "S", "hypothesis sampling seed", S::all},
+      {"seed", "segmentation.seed", "S", "hypothesis sampling seed", S::all},
       {"no_tracking",
-       {"segmentation.tracking"},
+       "segmentation.tracking",
        "",
        "two-frame segments (ids per frame) instead of tracked ids",
        S::all},
       {"no_segmentation",
-       {"pipeline.use_segmentation"},
+       "pipeline.use_segmentation",
        "",
        "ablation: every valid flow cell counts as static, no object labels",
        S::all},
       {"refine",
-       {"registration.refinement"},
+       "registration.refinement",
        "",
        "refinement of the static registration",
        S::all},
@@ -84,7 +84,7 @@ takes(PipelineStages app, PipelineStages flag)
 const FieldInfo<PipelineOptions>&
 fieldOf(const ParameterFlag& flag)
 {
-  return pipelineConfigTable().field(flag.keys.front());
+  return pipelineConfigTable().field(flag.key);
 }
 
 /// "none|icp|gicp" for a choice, else the flag's own value name.
@@ -103,9 +103,7 @@ valueName(const ParameterFlag& flag)
 Option
 optionOf(const ParameterFlag& flag)
 {
-  std::string keys;
-  for (const auto& key : flag.keys)
-    keys += (keys.empty() ? "" : ", ") + key;
+  const std::string& keys = flag.key;
   const bool is_switch = fieldOf(flag).kind == FieldKind::boolean;
   return {flag.name, is_switch ? "" : valueName(flag),
           flag.help + (is_switch
@@ -199,8 +197,7 @@ pipelineOptionsFromArguments(const Arguments& args)
     if (!args.has(flag.name))
       continue;
     const double value = flagValue(args, flag);
-    for (const auto& key : flag.keys)
-      pipelineConfigTable().field(key).set(options, value);
+    pipelineConfigTable().field(flag.key).set(options, value);
   }
   try {
     options.validate();

@@ -34,7 +34,8 @@ segmentFlow(const dynvo::test::SyntheticFlow& synthetic,
             const dynvo::RigidMotionSegmentationParameters& params = {})
 {
   dynvo::GridFlowData grid;
-  grid.assign(*synthetic.flow, CELL);
+  const auto& flow = *synthetic.flow;
+  grid.assign(flow, dynvo::FlowGrid(flow.width * CELL, flow.height * CELL, CELL));
   dynvo::SpatialSegmenter segmenter;
   dynvo::SpatialSegmentationResult result;
   segmenter.segment(grid, params, result);
