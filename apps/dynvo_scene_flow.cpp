@@ -1,8 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // dynvo_scene_flow: grid scene flow between frames I-1 and I of a recording, saved as PCD.
-#include <dynvo/app/cli.h>
-#include <dynvo/app/frame_source_args.h>
-#include <dynvo/app/output_guard.h>
+#include <dynvo/app/pipeline_args.h>
 #include <dynvo/io/partial_file.h>
 #include <dynvo/scene_flow/grid_scene_flow_estimation.h>
 
@@ -17,15 +15,19 @@
 #include <algorithm>
 #include <cstdio>
 #include <string>
-#include <thread>
 
 namespace {
 
 const char* const USAGE =
     "dynvo_scene_flow (-tum_dir DIR | -pcd_dir DIR | -oni FILE) -frame I -out flow.pcd "
-    "[-png flow.png] [-threads N] [-cell_size PX] [-window_size PX] "
-    "[-max_pyramid_level L] "
-    "[-fb_check full|local]";
+    "[-png flow.png] [options]";
+
+const char* const ABOUT =
+    "Computes the grid scene flow (docs/algorithm.md section 1) between two "
+    "consecutive "
+    "frames, with\nthe scene flow parameters of dynvo_odometry. In the PCD, x y z is "
+    "the "
+    "current point and prev_x\nprev_y prev_z the previous one (metres).";
 
 /// Draws each cell's 2D track over the current colour image and writes it as PNG.
 void
@@ -61,75 +63,39 @@ int
 main(int argc, char** argv)
 {
   return dynvo::app::runApp(USAGE, [&] {
-    const dynvo::GridSceneFlowParameters defaults;
-    const auto& fb_check_field =
-        dynvo::GridSceneFlowParameters::table().field("forward_backward_check");
-    const long hardware_threads = std::max(1U, std::thread::hardware_concurrency());
     const auto text = [](auto value) {
       return std::to_string(value);
     };
-    std::vector<dynvo::app::Option> options = dynvo::app::frameSourceOptions();
-    options.insert(
-        options.end(),
-        {{"frame", "I", "flow from frame I-1 to frame I, 0-based (required, >= 1)"},
-         {"out", "FILE", "PointFlow grid written as binary PCD (required)"},
-         {"png", "FILE", "also draw the 2D tracks over frame I"},
-         {"threads", "N",
-          "worker threads (default: hardware count, " + text(hardware_threads) + ")"},
-         {"cell_size", "PX",
-          "grid cell size (default " + text(defaults.cell_size) + ")"},
-         {"window_size", "PX",
-          "LK window side (default " + text(defaults.window_size) + ")"},
-         {"max_pyramid_level", "L",
-          "LK pyramid levels above the image (default " +
-              text(defaults.max_pyramid_level) + ")"},
-         {"fb_check", "full|local",
-          "forward-backward scheme (default " + fb_check_field.text(defaults) + ")"}});
-    const dynvo::app::Arguments args(argc, argv, options, 0);
+    const dynvo::app::Arguments args(
+        argc, argv,
+        dynvo::app::appOptions(
+            dynvo::app::PipelineStages::scene_flow,
+            {{"frame", "I", "flow from frame I-1 to frame I, 0-based (required, >= 1)"},
+             {"out", "FILE", "PointFlow grid written as binary PCD (required)"},
+             {"png", "FILE", "also draw the 2D tracks over frame I"}}));
     if (args.helpRequested()) {
-      std::printf(
-          "Usage: %s\n\nComputes the grid scene flow (docs/algorithm.md section 1) between "
-          "two consecutive frames.\nIn the PCD, x y z is the current point and prev_x "
-          "prev_y prev_z the previous one (metres).\n\n%s",
-          USAGE, args.optionsHelp().c_str());
+      std::printf("%s", dynvo::app::appHelp(USAGE, ABOUT, args).c_str());
       return 0;
     }
+    dynvo::app::setVerbosityFromArguments(args);
+    const auto options = dynvo::app::pipelineOptionsFromArguments(args);
+    if (dynvo::app::writeConfigIfRequested(args, options))
+      return 0;
     if (!args.has("frame") || !args.has("out"))
       throw dynvo::app::UsageError("-frame I and -out FILE are required");
     const long frame_index = args.integer("frame", 0);
     if (frame_index < 1)
       throw dynvo::app::UsageError("-frame must be >= 1, got " + text(frame_index));
-    const long threads = args.integer("threads", hardware_threads);
-    if (threads < 1 || threads > 256)
-      throw dynvo::app::UsageError("-threads must be in [1, 256], got " +
-                                   text(threads));
-    dynvo::GridSceneFlowParameters parameters;
-    parameters.cell_size =
-        static_cast<int>(args.integer("cell_size", defaults.cell_size));
-    parameters.window_size =
-        static_cast<int>(args.integer("window_size", defaults.window_size));
-    parameters.max_pyramid_level =
-        static_cast<int>(args.integer("max_pyramid_level", defaults.max_pyramid_level));
-    const std::string fb_check = args.string("fb_check", fb_check_field.text(defaults));
-    const int choice = fb_check_field.choiceIndex(fb_check);
-    if (choice < 0)
-      throw dynvo::app::UsageError("-fb_check must be full or local, got " + fb_check);
-    fb_check_field.set(parameters, choice);
 
+    // Configured as OdometryPipeline configures its scene flow.
     dynvo::GridSceneFlowEstimation<pcl::PointXYZRGB> estimation;
-    try {
-      estimation.setParameters(parameters);
-    }
-    catch (const std::invalid_argument& e) {
-      throw dynvo::app::UsageError(e.what());
-    }
-    estimation.setNumberOfThreads(static_cast<unsigned>(threads));
-    estimation.setCameraIntrinsics(dynvo::app::intrinsicsFromArguments(args));
+    estimation.setCameraIntrinsics(options.intrinsics);
+    estimation.setParameters(options.scene_flow);
+    estimation.setNumberOfThreads(options.threads);
 
     const dynvo::FrameSource::Ptr source = dynvo::app::openFrameSource(args);
-    dynvo::app::prepareOutputs(
-        {{"-out", args.string("out")}, {"-png", args.string("png")}},
-        source->inputPaths());
+    dynvo::app::prepareRunOutputs(
+        args, *source, {{"-out", args.string("out")}, {"-png", args.string("png")}});
     dynvo::Frame previous, current;
     for (long k = 0; k <= frame_index; ++k) {
       std::swap(previous, current);
@@ -168,7 +134,8 @@ main(int argc, char** argv)
                               static_cast<long>(count(&dynvo::PointFlow::valid_3d)));
     pcl::console::print_info(" with 3D, in ");
     pcl::console::print_value("%.2f", milliseconds);
-    pcl::console::print_info(" ms (%ld thread(s), both frames prepared)\n", threads);
+    pcl::console::print_info(" ms (%u thread(s), both frames prepared)\n",
+                             options.threads);
     return 0;
   });
 }

@@ -1,14 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // dynvo_odometry as users run it: outputs, closing lines, determinism and bad input.
 #include <dynvo/app/pipeline_config.h>
-#include <dynvo/app/synthesize.h>
 #include <dynvo/io/label_io.h>
 #include <dynvo/io/trajectory_io.h>
-#include <dynvo/synth/scene_synthesizer.h>
 
 #include <gtest/gtest.h>
 
 #include "support/run_command.h"
+#include "support/synthetic_sequence.h"
 #include "support/temp_dir.h"
 
 #include <cmath>
@@ -27,27 +26,23 @@ class OdometryApp : public ::testing::Test {
 protected:
   static void SetUpTestSuite()
   {
-    sequence_ = new TempDir();
-    dynvo::SynthOptions options;
-    options.scenario = "static_one";
-    options.frames = FRAMES;
-    dynvo::app::writeSyntheticSequence(options, sequence_->file("seq"), 2);
+    sequence_ = new dynvo::test::SyntheticSequence("static_one", FRAMES, 640, 480);
   }
 
   static void TearDownTestSuite() { delete sequence_; }
 
   std::string run(const std::string& flags) const
   {
-    return app_ + " -tum_dir " + sequence_->file("seq") + " " + flags;
+    return app_ + " -tum_dir " + sequence_->path() + " " + flags;
   }
 
   static constexpr int FRAMES = 35; // over 1 s at 30 Hz, so that RPE has pairs
-  static TempDir* sequence_;
+  static dynvo::test::SyntheticSequence* sequence_;
   TempDir out_;
   const std::string app_ = DYNVO_ODOMETRY_BIN;
 };
 
-TempDir* OdometryApp::sequence_ = nullptr;
+dynvo::test::SyntheticSequence* OdometryApp::sequence_ = nullptr;
 
 TEST_F(OdometryApp, WritesTrajectoryLabelsObjectsAndClosingLines)
 {
@@ -86,11 +81,8 @@ TEST_F(OdometryApp, SameSeedSameBytesWithOneAndTwoThreads)
   // A moving camera (the fixture's camera stands still, where a run that lost every frame
   // would write identity poses with any thread count).
   const int frames = 10;
-  dynvo::SynthOptions options;
-  options.scenario = "moving_static";
-  options.frames = frames;
-  dynvo::app::writeSyntheticSequence(options, out_.file("moving"), 2);
-  const std::string app = app_ + " -tum_dir " + out_.file("moving");
+  const dynvo::test::SyntheticSequence moving("moving_static", frames, 640, 480);
+  const std::string app = app_ + " -tum_dir " + moving.path();
   for (const char* threads : {"1", "2"}) {
     const auto result = runCommand(app + " -threads " + threads + " -out " +
                                    out_.file(std::string("t") + threads + ".txt"));
@@ -162,7 +154,7 @@ TEST_F(OdometryApp, WrittenConfigReproducesTheRunForEveryField)
 TEST_F(OdometryApp, CorruptFrameStopsTheRunButKeepsWhatWasComputed)
 {
   // Copy the sequence and corrupt the colour image of frame 6.
-  fs::copy(sequence_->file("seq"), out_.file("seq"), fs::copy_options::recursive);
+  fs::copy(sequence_->path(), out_.file("seq"), fs::copy_options::recursive);
   std::vector<fs::path> colour;
   for (const auto& entry : fs::directory_iterator(out_.file("seq") + "/rgb"))
     colour.push_back(entry.path());

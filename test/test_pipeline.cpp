@@ -14,6 +14,8 @@
 #include <filesystem>
 #include <limits>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace {
 
@@ -147,22 +149,67 @@ TEST(OdometryPipeline, ThreadCountDoesNotChangeTheResult)
         << "frame " << k;
 }
 
-TEST(OdometryPipeline, RejectsFramesThatChangeSizeOrAreNotOrganized)
+TEST(OdometryPipeline, ReportsBadFramesAsLostWithoutThrowing)
 {
   dynvo::app::PipelineOptions options;
   dynvo::app::OdometryPipeline pipeline(options);
   auto organized = pcl::make_shared<Cloud>(64, 48, pcl::PointXYZRGB(0.f, 0.f, 1.f));
-  EXPECT_NO_THROW(pipeline.process(organized, 0.0));
-  EXPECT_THROW(pipeline.process(pcl::make_shared<Cloud>(32, 48), 0.1),
-               std::invalid_argument);
+  EXPECT_TRUE(pipeline.process(organized, 0.0).error.empty());
   auto flat = pcl::make_shared<Cloud>();
   flat->resize(100);
-  EXPECT_THROW(pipeline.process(flat, 0.2), std::invalid_argument);
-  EXPECT_THROW(pipeline.process(nullptr, 0.3), std::invalid_argument);
+  const std::vector<std::pair<Cloud::ConstPtr, std::string>> bad = {
+      {pcl::make_shared<Cloud>(32, 48), "frame size changed from 64x48 to 32x48"},
+      {flat, "organized"},
+      {nullptr, "got none"}};
+  for (const auto& [cloud, reason] : bad) {
+    const dynvo::app::FrameResult* result = nullptr;
+    ASSERT_NO_THROW(result = &pipeline.process(cloud, 0.1));
+    EXPECT_TRUE(result->lost) << reason;
+    EXPECT_NE(result->error.find(reason), std::string::npos) << result->error;
+    EXPECT_TRUE(result->T_world_curr.allFinite());
+    EXPECT_EQ(result->labels.size(),
+              static_cast<std::size_t>(result->width) * result->height);
+  }
   EXPECT_EQ(pipeline.frameCount(), 1u);
+  EXPECT_TRUE(pipeline.process(organized, 0.2).error.empty());
+  EXPECT_EQ(pipeline.frameCount(), 2u);
 
   options.threads = 0;
   EXPECT_THROW(dynvo::app::OdometryPipeline{options}, std::invalid_argument);
+}
+
+TEST(OdometryPipeline, ABadFrameLeavesTheRestOfTheRunUntouched)
+{
+  // The bad frame keeps the sequence state, so every good frame is registered against the
+  // same previous frame as in the run without it: the poses are the same bits.
+  dynvo::SynthOptions synth_options;
+  synth_options.scenario = "moving_crossing";
+  synth_options.frames = 8;
+  dynvo::SceneSynthesizer synth(synth_options);
+  dynvo::app::PipelineOptions options;
+  options.intrinsics = synth.intrinsics();
+  dynvo::app::OdometryPipeline clean(options);
+  dynvo::app::OdometryPipeline interrupted(options);
+  Eigen::Matrix4d last = Eigen::Matrix4d::Identity();
+  for (int k = 0; k < synth_options.frames; ++k) {
+    const dynvo::SynthFrame frame = synth.render(k);
+    const auto cloud =
+        dynvo::makeOrganizedCloud(frame.color, frame.depth, synth.intrinsics());
+    if (k == 3) {
+      const auto& skipped = interrupted.process(
+          pcl::make_shared<Cloud>(cloud->width / 2, cloud->height), frame.timestamp);
+      ASSERT_TRUE(skipped.lost);
+      ASSERT_FALSE(skipped.error.empty());
+    }
+    const Eigen::Matrix4d expected = clean.process(cloud, frame.timestamp).T_world_curr;
+    const auto& result = interrupted.process(cloud, frame.timestamp);
+    EXPECT_TRUE(result.error.empty()) << k;
+    EXPECT_FALSE(result.lost) << k;
+    EXPECT_EQ(result.T_world_curr, expected) << k;
+    last = expected;
+  }
+  // Not vacuous: the camera moved.
+  EXPECT_GT((last.topRightCorner<3, 1>().norm()), 1e-3);
 }
 
 TEST(OdometryPipeline, InlierThresholdFollowsTheMeasuredNoise)
@@ -174,7 +221,9 @@ TEST(OdometryPipeline, InlierThresholdFollowsTheMeasuredNoise)
   const SequenceRun run = runScenario("moving_static", 20);
   EXPECT_DOUBLE_EQ(run.inlier_threshold[1], defaults.segmentation.inlier_threshold);
   for (std::size_t k = 2; k < run.inlier_threshold.size(); ++k)
-    EXPECT_DOUBLE_EQ(run.inlier_threshold[k], defaults.min_inlier_threshold) << k;
+    EXPECT_DOUBLE_EQ(run.inlier_threshold[k],
+                     defaults.inlier_noise.min_inlier_threshold)
+        << k;
 }
 
 TEST(OdometryPipeline, InlierThresholdStaysLooseOnRealKinectFrames)
@@ -203,16 +252,17 @@ TEST(OdometryPipeline, InlierThresholdStaysLooseOnRealKinectFrames)
   }
   ASSERT_EQ(frames, 30);
   RecordProperty("mean_inlier_threshold", std::to_string(sum / frames));
-  EXPECT_GT(sum / frames, 1.5 * options.min_inlier_threshold);
+  EXPECT_GT(sum / frames, 1.5 * options.inlier_noise.min_inlier_threshold);
 }
 
 TEST(OdometryPipeline, NoiseFollowingThresholdBoundsAreValidated)
 {
   dynvo::app::PipelineOptions options;
-  options.min_inlier_threshold = 2.0f * options.segmentation.inlier_threshold;
+  options.inlier_noise.min_inlier_threshold =
+      2.0f * options.segmentation.inlier_threshold;
   EXPECT_THROW(dynvo::app::OdometryPipeline{options}, std::invalid_argument);
-  options.min_inlier_threshold = 3e-5f;
-  options.inlier_noise_factor = -1.0f;
+  options.inlier_noise.min_inlier_threshold = 3e-5f;
+  options.inlier_noise.inlier_noise_factor = -1.0f;
   EXPECT_THROW(dynvo::app::OdometryPipeline{options}, std::invalid_argument);
 }
 

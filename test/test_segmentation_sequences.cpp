@@ -99,7 +99,6 @@ runSequence(const std::string& scenario,
   flow_estimation.setCellSize(CELL);
   dynvo::RigidMotionSegmentation<Point> segmentation;
   segmentation.setCameraIntrinsics(synth.intrinsics());
-  segmentation.setCellSize(CELL);
   segmentation.setTracking(tracking);
   segmentation.setObjectSeparationRatio(separation_ratio);
 

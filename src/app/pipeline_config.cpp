@@ -63,12 +63,6 @@ PipelineOptions::table()
   static const ParameterTable<P> table(std::vector<ParameterTable<P>::Field>{
       makeField("use_segmentation", &P::use_segmentation, R::any(),
                 "0 = ablation: every valid flow cell is static"),
-      makeField("static_consensus", &P::static_consensus, R::atLeast(0),
-                "x inlier threshold, 0 = off"),
-      makeField("inlier_noise_factor", &P::inlier_noise_factor, R::atLeast(0),
-                "x mean static residual, 0 = off"),
-      makeField("min_inlier_threshold", &P::min_inlier_threshold, R::above(0),
-                "m^2, <= segmentation.inlier_threshold"),
       makeField("threads", &P::threads, R::atLeast(1), "worker threads"),
   });
   return table;
@@ -78,6 +72,8 @@ const ParameterTable<PipelineOptions>&
 pipelineConfigTable()
 {
   using P = PipelineOptions;
+  const auto& own = P::table();
+  // The keys of the pipeline map keep the order of the files written so far.
   static const ParameterTable<P> table{
       nestFields("scene_flow", &P::scene_flow,
                  GridSceneFlowParameters::table().fields()),
@@ -85,7 +81,12 @@ pipelineConfigTable()
                  RigidMotionSegmentationParameters::table().fields()),
       nestFields("registration", &P::registration,
                  StaticSceneRegistrationParameters::table().fields()),
-      prefixFields("pipeline", P::table().fields())};
+      prefixFields("pipeline", {own.field("use_segmentation")}),
+      nestFields("pipeline", &P::static_set,
+                 StaticSetSelectionParameters::table().fields()),
+      nestFields("pipeline", &P::inlier_noise,
+                 InlierNoiseTrackerParameters::table().fields()),
+      prefixFields("pipeline", {own.field("threads")})};
   return table;
 }
 

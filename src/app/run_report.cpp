@@ -70,7 +70,8 @@ RunOutputs::add(const FrameResult& result)
   pose.T_world_camera = T_world_start_ * Eigen::Isometry3d(result.T_world_curr);
   trajectory_.push_back(pose);
 
-  if (!labels_dir_.empty())
+  // A frame the pipeline could not process (result.error) has no image to label.
+  if (!labels_dir_.empty() && result.error.empty())
     writeLabelImage((fs::path(labels_dir_) / stampedPngName(result.timestamp)).string(),
                     {result.width, result.height, result.labels});
   if (objects_.is_open()) {

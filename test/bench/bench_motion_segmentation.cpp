@@ -56,6 +56,15 @@ sequence(bool noise)
   return noise ? noisy : clean;
 }
 
+/// The cell geometry of a frame's flow.
+dynvo::FlowGrid
+gridOf(const FlowFrame& frame)
+{
+  dynvo::FlowGrid grid;
+  dynvo::FlowGrid::fromFlow(*frame.flow, frame.cloud->width, frame.cloud->height, grid);
+  return grid;
+}
+
 /// §3 alone (hypotheses, refinement, DBSCAN, labelling) on plain buffers. Arg: noise.
 void
 BM_SpatialSegmentation(benchmark::State& state)
@@ -64,7 +73,7 @@ BM_SpatialSegmentation(benchmark::State& state)
   const dynvo::RigidMotionSegmentationParameters params;
   std::vector<dynvo::GridFlowData> grids(frames.size());
   for (std::size_t k = 0; k < frames.size(); ++k) {
-    grids[k].assign(*frames[k].flow, 16);
+    grids[k].assign(*frames[k].flow, gridOf(frames[k]));
     grids[k].setSensorNoise(params.noise, 525.0f, 1.0f, 1.0f);
   }
   dynvo::SpatialSegmenter segmenter;
@@ -123,7 +132,7 @@ BM_SegmentTracking(benchmark::State& state)
   std::vector<dynvo::SpatialSegmentationResult> spatial(frames.size());
   dynvo::SpatialSegmenter segmenter;
   for (std::size_t k = 0; k < frames.size(); ++k) {
-    grids[k].assign(*frames[k].flow, params.cell_size);
+    grids[k].assign(*frames[k].flow, gridOf(frames[k]));
     grids[k].setSensorNoise(params.noise, 525.0f, 1.0f, 1.0f);
     segmenter.segment(grids[k], params, spatial[k]);
   }

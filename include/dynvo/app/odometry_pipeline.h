@@ -6,7 +6,9 @@
 #include <dynvo/common/export.h>
 #include <dynvo/common/parameter_table.h>
 #include <dynvo/motion_segmentation/rigid_motion_segmentation_parameters.h>
+#include <dynvo/registration/inlier_noise_tracker.h>
 #include <dynvo/registration/static_scene_registration_parameters.h>
+#include <dynvo/registration/static_set_selection_parameters.h>
 #include <dynvo/scene_flow/grid_scene_flow_parameters.h>
 
 #include <pcl/PointIndices.h>
@@ -18,20 +20,18 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace dynvo::app {
 
-/// Every knob of the pipeline: the three modules' parameters plus the pipeline's own.
+/// Every knob of the pipeline: the modules' parameters plus the pipeline's own.
 struct DYNVO_EXPORTS PipelineOptions {
-  /// The modules' defaults, except two:
+  /// The modules' defaults, except two (the measurements behind them: src/app/NOTES.md):
   /// - the segmentation's inlier threshold: 6e-5 m^2 (7.7 mm) instead of the paper's 3e-5,
-  ///   because with real Kinect noise too few hypotheses pass at 3e-5 (TUM fr1/xyz: RPE
-  ///   0.053 m/s and 5 lost frames at 3e-5, 0.036 m/s and 1 at 6e-5);
+  ///   for real Kinect noise; it is also the upper bound of the noise-following threshold;
   /// - the scene flow's depth window radius: 6 px (a 7x7 sample of a 13x13 window) instead
-  ///   of the single pixel. At 2 m one Kinect pixel is about 9 mm noisy between two frames,
-  ///   beyond the 7.7 mm inlier radius, so the background split into many segments whose
-  ///   fits were biased by the selection (synthetic moving_static: RPE 0.027 -> 0.001 m/s).
+  ///   of the single pixel, so that the depth noise at c_i stays below the inlier radius.
   PipelineOptions();
 
   CameraIntrinsics intrinsics;        ///< back-projection of the input frames
@@ -41,32 +41,16 @@ struct DYNVO_EXPORTS PipelineOptions {
   StaticSceneRegistrationParameters registration; ///< docs/algorithm.md §7
   bool use_segmentation =
       true; ///< false: ablation, every valid flow cell counts as static
-  /// Static support (multiple of the segmentation's inlier threshold in use, 0 = off): after
-  /// a first fit on the background segment, every valid cell outside the moving objects whose
-  /// flow agrees with it within this many thresholds (2: 7.7 mm on the synthetic scenes,
-  /// 11 mm on TUM fr1) joins the static set for the final fit. Tied to the noise-following
-  /// threshold rather than to a fixed radius, because a loose radius lets a slow object's
-  /// unsegmented cells in (a box covering 80 % of the image moved the estimate by up to
-  /// 10 mm per frame at 4 x 3e-5). When that first fit departs from the constant-velocity
-  /// prediction by more than the segmentation's static_guard_tolerance (tau_cv, a moving
-  /// object took the background label for a frame), the cells within tau_cv of the
-  /// prediction give the first fit instead, and labels are not trusted.
-  float static_consensus = 2.0f;
-  /// Noise-following inlier threshold (0 = off: segmentation.inlier_threshold throughout).
-  /// Each frame's segmentation uses this factor times the running mean (weight 0.1 per frame)
-  /// of the static fit's mean residual E (its fitness score), clamped to
-  /// [min_inlier_threshold, segmentation.inlier_threshold]; before the first fit, the upper
-  /// bound. Residuals of a Gaussian static scene are sigma^2 chi^2_3 with mean 3 sigma^2, so
-  /// 3 times the mean keeps about 97 % of the static cells. Measured mean residual: about
-  /// 2e-6 m^2 on the synthetic scenes (the paper's 3e-5 applies) and 1.9e-5 on TUM fr1/xyz,
-  /// whose colour and depth images are not taken at the same instant (6e-5 applies).
-  float inlier_noise_factor = 3.0f;
-  float min_inlier_threshold =
-      3e-5f;            ///< lower bound of the noise-following threshold (m^2)
+  /// Static consensus and motion guard (StaticSetSelection; YAML pipeline.static_consensus);
+  /// tau_cv is segmentation.static_guard_tolerance.
+  StaticSetSelectionParameters static_set;
+  /// Noise-following inlier threshold (InlierNoiseTracker; YAML pipeline.inlier_noise_factor
+  /// and pipeline.min_inlier_threshold), bounded above by segmentation.inlier_threshold.
+  InlierNoiseTrackerParameters inlier_noise;
   unsigned threads = 1; ///< worker threads; results do not depend on it
 
-  /// Names, units and ranges of the pipeline's own fields above (use_segmentation ...
-  /// threads), in file order; the modules' fields are in their Parameters::table().
+  /// Names, units and ranges of the pipeline's own fields use_segmentation and threads; the
+  /// modules' fields, static_set's and inlier_noise's are in their Parameters::table().
   static const ParameterTable<PipelineOptions>& table();
 
   /// \throws std::invalid_argument when a module's parameters or a pipeline value are invalid
@@ -88,8 +72,9 @@ struct FrameResult {
       Eigen::Matrix4d::Identity(); ///< camera pose (camera-to-world)
   Eigen::Matrix4d T_curr_prev =
       Eigen::Matrix4d::Identity(); ///< ego-motion H_k (identity at frame 0)
-  bool lost =
-      false; ///< too few static cells: T_curr_prev is the constant-velocity prediction
+  /// no ego-motion (too few static cells, or a bad frame: see error); T_curr_prev is then
+  /// the constant-velocity prediction
+  bool lost = false;
   /// segments[0] = static background pixels, then moving objects (pcl::PointIndices each)
   std::vector<pcl::PointIndices> segments;
   std::vector<std::uint8_t> segment_labels; ///< label id of each segment (1 = static)
@@ -101,13 +86,19 @@ struct FrameResult {
   std::uint32_t width = 0;  ///< image columns (px)
   std::uint32_t height = 0; ///< image rows (px)
   std::vector<std::uint8_t>
-      labels;       ///< per pixel: 0 no measurement, 1 static, 2.. objects
-  StageTimes times; ///< stage timings
+      labels;        ///< per pixel: 0 no measurement, 1 static, 2.. objects
+  StageTimes times;  ///< stage timings
+  std::string error; ///< why the frame was not processed (then lost); empty when it was
 };
 
-/** \brief Chains GridSceneFlowEstimation, RigidMotionSegmentation and StaticSceneRegistration
- * over a sequence and composes the camera poses (T_world_curr = T_world_prev * T_prev_curr;
- * frame 0 is the world frame).
+/** \brief Chains GridSceneFlowEstimation, RigidMotionSegmentation, StaticSetSelection (on
+ * StaticSceneRegistration) and InlierNoiseTracker over a sequence and composes the camera poses
+ * (T_world_curr = T_world_prev * T_prev_curr; frame 0 is the world frame).
+ *
+ * A frame that breaks the contract (null, unorganized, odd-sized or of another size than the
+ * first frame) is reported with PCL_WARN and in FrameResult::error, and flagged lost:
+ * T_curr_prev is the constant-velocity prediction and the sequence goes on with the next
+ * frame as if the bad one had not come (it does not become the previous frame).
  * \code
  * dynvo::app::PipelineOptions options;
  * options.intrinsics = dynvo::CameraIntrinsics::fromPreset("fr1");
@@ -130,8 +121,8 @@ public:
   /** \brief Processes the next frame of the sequence.
    * \param[in] cloud organized frame (metres, NaN where no depth), same size every frame
    * \param[in] timestamp seconds
-   * \return the frame's result, valid until the next call
-   * \throws std::invalid_argument when the cloud is null, unorganized or changes size
+   * \return the frame's result, valid until the next call; a bad frame gives a lost result
+   *         with FrameResult::error set (see the class doc)
    */
   const FrameResult& process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& cloud,
                              double timestamp);

@@ -33,7 +33,9 @@ public:
              const std::string& objects_path,
              const Trajectory* initial_groundtruth = nullptr);
 
-  /// Records one frame. \throws pcl::IOException when a file cannot be written
+  /// Records one frame; a frame the pipeline could not process (FrameResult::error) gets a
+  /// trajectory line but no label image. \throws pcl::IOException when a file cannot be
+  /// written
   void add(const FrameResult& result);
 
   /// Writes the trajectory and moves the objects file into place, when a frame was added.

@@ -89,4 +89,14 @@ squaredTransferError(const Eigen::Matrix4d& T_target_source,
       .squaredNorm();
 }
 
+/// Inverse of a rigid motion: [R^T, -R^T t] (exact for a rotation R, unlike a general inverse).
+inline Eigen::Matrix4d
+rigidInverse(const Eigen::Matrix4d& T)
+{
+  Eigen::Matrix4d inv = Eigen::Matrix4d::Identity();
+  inv.topLeftCorner<3, 3>() = T.topLeftCorner<3, 3>().transpose();
+  inv.topRightCorner<3, 1>() = -inv.topLeftCorner<3, 3>() * T.topRightCorner<3, 1>();
+  return inv;
+}
+
 } // namespace dynvo

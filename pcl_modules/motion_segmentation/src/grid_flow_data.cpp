@@ -8,12 +8,10 @@
 namespace dynvo {
 
 void
-GridFlowData::assign(const pcl::PointCloud<PointFlow>& flow, int cell_size_px)
+GridFlowData::assign(const pcl::PointCloud<PointFlow>& flow, const FlowGrid& grid)
 {
   constexpr float NaN = std::numeric_limits<float>::quiet_NaN();
-  cols = static_cast<int>(flow.width);
-  rows = static_cast<int>(flow.height);
-  cell_size = cell_size_px;
+  geometry = FlowGrid(grid.image_width, grid.image_height, grid.cell_size);
   const std::size_t n = flow.size();
   valid_2d.resize(n);
   valid_3d.resize(n);

@@ -12,11 +12,9 @@ RigidMotionSegmentationParameters::table()
 {
   using P = RigidMotionSegmentationParameters;
   using R = FieldRange;
-  static_assert(AGGREGATE_FIELD_COUNT<P> == 31, "every field of P needs a row below");
+  static_assert(AGGREGATE_FIELD_COUNT<P> == 30, "every field of P needs a row below");
   using Fields = std::vector<ParameterTable<P>::Field>;
   static const ParameterTable<P> table{Fields{
-      makeField("cell_size", &P::cell_size, R::atLeast(2),
-                "w_grid, px, = scene flow's"),
       makeField("max_hypotheses", &P::max_hypotheses, R::closed(1, 254), "h_max"),
       makeField("max_trials", &P::max_trials, R::atLeast(1),
                 "T_max, >= max_hypotheses"),

@@ -83,15 +83,15 @@ SegmentTracker::warpNearest(const std::vector<std::uint8_t>& map,
                             const GridFlowData& grid) const
 {
   std::vector<std::uint8_t> warped(grid.size(), 0);
-  const float half = static_cast<float>(grid.cell_size / 2);
+  const float half = static_cast<float>(grid.cellSize() / 2);
   for (std::size_t i = 0; i < grid.size(); ++i) {
     if (!grid.valid_2d[i])
       continue;
     const Eigen::Vector2f& p = grid.previous_pixel[i];
-    const long a = std::lround((p.x() - half) / grid.cell_size);
-    const long b = std::lround((p.y() - half) / grid.cell_size);
-    if (a >= 0 && a < grid.cols && b >= 0 && b < grid.rows)
-      warped[i] = map[static_cast<std::size_t>(b) * grid.cols + a];
+    const long a = std::lround((p.x() - half) / grid.cellSize());
+    const long b = std::lround((p.y() - half) / grid.cellSize());
+    if (a >= 0 && a < grid.cols() && b >= 0 && b < grid.rows())
+      warped[i] = map[static_cast<std::size_t>(b) * grid.cols() + a];
   }
   return warped;
 }
@@ -122,11 +122,11 @@ SegmentTracker::sourcePixels(const GridFlowData& grid,
     // (2) Median displacement of the tracked 3x3 neighbours; (3) zero.
     dx.clear();
     dy.clear();
-    const int col = static_cast<int>(i % grid.cols),
-              row = static_cast<int>(i / grid.cols);
-    for (int r = std::max(0, row - 1); r <= std::min(grid.rows - 1, row + 1); ++r)
-      for (int c = std::max(0, col - 1); c <= std::min(grid.cols - 1, col + 1); ++c) {
-        const std::size_t j = static_cast<std::size_t>(r) * grid.cols + c;
+    const int col = static_cast<int>(i % grid.cols()),
+              row = static_cast<int>(i / grid.cols());
+    for (int r = std::max(0, row - 1); r <= std::min(grid.rows() - 1, row + 1); ++r)
+      for (int c = std::max(0, col - 1); c <= std::min(grid.cols() - 1, col + 1); ++c) {
+        const std::size_t j = static_cast<std::size_t>(r) * grid.cols() + c;
         if (!grid.valid_2d[j])
           continue;
         const Eigen::Vector2f d = grid.previous_pixel[j] - grid.cellCentre(j);
@@ -479,13 +479,13 @@ SegmentTracker::update(const GridFlowData& grid,
                        const CameraIntrinsics& intrinsics,
                        const RigidMotionSegmentationParameters& params)
 {
-  if (model_.cols() != grid.cols || model_.rows() != grid.rows ||
+  if (model_.cols() != grid.cols() || model_.rows() != grid.rows() ||
       model_.labels() != params.max_labels) {
     if (model_.cols() != 0)
       PCL_DEBUG(
           "[dynvo::SegmentTracker::update] grid or label count changed; restarting.\n");
     reset();
-    model_.reset(grid.cols, grid.rows, params.max_labels);
+    model_.reset(grid.cols(), grid.rows(), params.max_labels);
   }
   collectUsedIds(params.max_labels);
   for (auto& map : buffer_)
@@ -505,7 +505,7 @@ SegmentTracker::update(const GridFlowData& grid,
 
   // §6 then §5: carry the models into the current grid, fold in Ghat, read out L.
   sourcePixels(grid, T_pred, intrinsics);
-  model_.compensate(source_, grid.valid_2d, grid.cell_size);
+  model_.compensate(source_, grid.valid_2d, grid.cellSize());
   model_.update(tracked_, params.max_age);
 
   collectOutputs(grid, spatial, ids, T_pred);

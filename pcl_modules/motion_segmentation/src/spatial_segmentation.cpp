@@ -318,8 +318,8 @@ SpatialSegmenter::segment(const GridFlowData& grid,
   result.sizes.clear();
   result.hypotheses.clear();
   result.trials = 0;
-  cols_ = grid.cols;
-  rows_ = grid.rows;
+  cols_ = grid.cols();
+  rows_ = grid.rows();
   packed_of_cell_.assign(grid.size(), -1);
   cell_of_packed_.clear();
   a_.clear();

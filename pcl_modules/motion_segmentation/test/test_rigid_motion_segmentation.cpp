@@ -36,7 +36,6 @@ TYPED_TEST(RigidMotionSegmentationTyped, KnownMotionsGivePixelSegments)
   const auto cloud = dynvo::test::cloudFromFlow<TypeParam>(*synthetic.flow, CELL);
 
   dynvo::RigidMotionSegmentation<TypeParam> segmentation;
-  segmentation.setCellSize(CELL);
   segmentation.setTracking(false);
   segmentation.setInputCloud(cloud);
   segmentation.setInputFlow(synthetic.flow);
@@ -45,6 +44,9 @@ TYPED_TEST(RigidMotionSegmentationTyped, KnownMotionsGivePixelSegments)
   ASSERT_EQ(segments.size(), 2u);
   ASSERT_EQ(segmentation.getMotions().size(), 2u);
   EXPECT_EQ(segmentation.getSegmentLabels(), (std::vector<std::uint8_t>{1, 2}));
+  // The 4 px cell size comes from the flow grid: 160 px / 40 columns.
+  EXPECT_EQ(segmentation.getCellGrid().cell_size, static_cast<std::uint32_t>(CELL));
+  EXPECT_EQ(segmentation.getCellGrid().labels, segmentation.getCellLabels());
   // Pixel indices: every finite pixel of the segment's cells, ascending, nothing else.
   const std::vector<std::uint8_t>& cells = segmentation.getCellLabels();
   for (std::size_t s = 0; s < segments.size(); ++s) {
@@ -72,7 +74,6 @@ TYPED_TEST(RigidMotionSegmentationTyped, SameFrameTwiceGivesOneStaticSegment)
   const auto synthetic = dynvo::test::makeSyntheticFlow(
       40, 30, CELL, dynvo::test::intrinsicsFor(160), Eigen::Matrix4d::Identity(), {});
   dynvo::RigidMotionSegmentation<TypeParam> segmentation;
-  segmentation.setCellSize(CELL);
   segmentation.setTracking(false);
   segmentation.setInputCloud(
       dynvo::test::cloudFromFlow<TypeParam>(*synthetic.flow, CELL));
@@ -95,7 +96,6 @@ TEST(RigidMotionSegmentationDeterminism, SameSeedSameOutputForOneAndTwoThreads)
       dynvo::test::cloudFromFlow<pcl::PointXYZRGB>(*synthetic.flow, CELL);
   const auto run = [&](unsigned threads) {
     dynvo::RigidMotionSegmentation<pcl::PointXYZRGB> segmentation;
-    segmentation.setCellSize(CELL);
     segmentation.setSeed(7);
     segmentation.setNumberOfThreads(threads);
     segmentation.setInputCloud(cloud);
@@ -137,24 +137,23 @@ TEST(RigidMotionSegmentationContract, BadInputsClearOutputs)
   EXPECT_TRUE(segments.empty());
 
   Segmentation no_flow;
-  no_flow.setCellSize(CELL);
   no_flow.setInputCloud(cloud);
   segments.resize(2);
   no_flow.segment(segments);
   EXPECT_TRUE(segments.empty());
 
-  // A flow grid that belongs to 16 px cells does not fit 4 px cells of this cloud.
+  // A 10x10 flow grid does not tile this 160x120 cloud (16 px cells would give 7 rows).
   Segmentation mismatched;
   mismatched.setInputCloud(cloud);
-  mismatched.setInputFlow(synthetic.flow);
+  mismatched.setInputFlow(pcl::make_shared<pcl::PointCloud<dynvo::PointFlow>>(10, 10));
   segments.resize(2);
   mismatched.segment(segments);
   EXPECT_TRUE(segments.empty());
   EXPECT_TRUE(mismatched.getCellLabels().empty());
+  EXPECT_EQ(mismatched.getCellGrid().size(), 0u);
   EXPECT_TRUE(mismatched.getMotions().empty());
 
   Segmentation unorganized;
-  unorganized.setCellSize(CELL);
   pcl::PointCloud<pcl::PointXYZRGB>::Ptr flat(
       new pcl::PointCloud<pcl::PointXYZRGB>(*cloud));
   flat->width = static_cast<std::uint32_t>(flat->size());
@@ -188,7 +187,6 @@ TEST(RigidMotionSegmentationContract, VgaFrameWithDefaultCells)
 TEST(RigidMotionSegmentationContract, BadParametersThrow)
 {
   dynvo::RigidMotionSegmentation<pcl::PointXYZRGB> segmentation;
-  EXPECT_THROW(segmentation.setCellSize(1), std::invalid_argument);
   EXPECT_THROW(segmentation.setInlierThreshold(0.0f), std::invalid_argument);
   EXPECT_THROW(segmentation.setSampleSize(2), std::invalid_argument);
   EXPECT_THROW(segmentation.setMaxHypotheses(0), std::invalid_argument);
@@ -206,7 +204,8 @@ TEST(RigidMotionSegmentationContract, BadParametersThrow)
   nan_motion(0, 3) = std::numeric_limits<float>::quiet_NaN();
   EXPECT_THROW(segmentation.setPredictedMotion(nan_motion), std::invalid_argument);
   // A failed setter keeps the previous value.
-  EXPECT_EQ(segmentation.getCellSize(), 16);
+  EXPECT_EQ(segmentation.getSampleSize(),
+            dynvo::RigidMotionSegmentationParameters{}.sample_size);
   EXPECT_FLOAT_EQ(segmentation.getInlierThreshold(),
                   dynvo::RigidMotionSegmentationParameters{}.inlier_threshold);
 }

@@ -215,7 +215,6 @@ protected:
 
   void SetUp() override
   {
-    segmentation.setCellSize(CELL);
     segmentation.setCameraIntrinsics(dynvo::test::intrinsicsFor(160));
   }
 
@@ -278,7 +277,6 @@ boxLabels(const std::vector<double>& steps, float separation_ratio, float hold =
 {
   constexpr int CELL = 4;
   dynvo::RigidMotionSegmentation<pcl::PointXYZRGB> segmentation;
-  segmentation.setCellSize(CELL);
   segmentation.setCameraIntrinsics(dynvo::test::intrinsicsFor(160));
   segmentation.setObjectSeparationRatio(separation_ratio);
   if (separation_ratio > 0.0f)

@@ -34,7 +34,8 @@ segmentFlow(const dynvo::test::SyntheticFlow& synthetic,
             const dynvo::RigidMotionSegmentationParameters& params = {})
 {
   dynvo::GridFlowData grid;
-  grid.assign(*synthetic.flow, CELL);
+  const auto& flow = *synthetic.flow;
+  grid.assign(flow, dynvo::FlowGrid(flow.width * CELL, flow.height * CELL, CELL));
   if (params.residual_model == dynvo::ResidualModel::sensor)
     grid.setSensorNoise(params.noise, static_cast<float>(smallIntrinsics().fx), 1.0f,
                         1.0f);

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <dynvo/registration/static_scene_registration.h>
 
-#include "box_scene.h"
+#include "registration_scene.h"
 
 #include <pcl/point_types.h>
 
@@ -17,67 +17,7 @@
 namespace {
 
 using dynvo::StaticRegistrationStatus;
-using dynvo::test::BoxScene;
-using dynvo::test::cellPixels;
-using dynvo::test::rotationErrorDeg;
-using dynvo::test::translationError;
-
-constexpr std::uint32_t CELL = 16; // w_grid (px), docs/algorithm.md §0
-
-// Noise-free correspondences are float copies of exact points at <= 4 m: round-off is
-// ~2e-7 m per coordinate, so 1 mm and 0.05 degrees (the brief's accuracy) leave a margin of
-// three orders of magnitude while still failing on any systematic error such as a swapped
-// direction (2 degrees / 3.7 cm here) or an untrimmed outlier bias (> 1 mm, checked below).
-constexpr double TRANSLATION_TOL = 1e-3; // metres
-constexpr double ROTATION_TOL = 0.05;    // degrees
-
-/// A frame pair of the box scene with its flow grid and the static cells.
-template <typename PointT> struct FramePair {
-  dynvo::test::RenderedFrame<PointT> previous;
-  dynvo::test::RenderedFrame<PointT> current;
-  pcl::PointCloud<dynvo::PointFlow>::Ptr flow;
-  std::vector<std::uint8_t> static_cells;
-  std::uint32_t cols = 0;
-
-  explicit FramePair(const BoxScene& scene)
-      : previous(scene.render<PointT>(false))
-      , current(scene.render<PointT>(true))
-  {
-    flow.reset(
-        new pcl::PointCloud<dynvo::PointFlow>(scene.flow(current, CELL, static_cells)));
-    cols = scene.width / CELL;
-  }
-
-  /// Every pixel of the static cells.
-  pcl::PointIndices::Ptr staticPixels(std::uint32_t width) const
-  {
-    return cellPixels(static_cells, cols, CELL, width);
-  }
-
-  /// The pixels of the static cells that see a static box (cells at the moving box's border
-  /// also hold some of its pixels, which a point-based refinement must not get).
-  pcl::PointIndices::Ptr staticSurfacePixels(const BoxScene& scene) const
-  {
-    pcl::PointIndices::Ptr indices = staticPixels(scene.width);
-    auto& list = indices->indices;
-    list.erase(std::remove_if(list.begin(), list.end(),
-                              [&](int index) {
-                                const int box =
-                                    current.box[static_cast<std::size_t>(index)];
-                                return box < 0 || scene.boxes[box].moving;
-                              }),
-               list.end());
-    return indices;
-  }
-
-  std::size_t staticCellCount() const
-  {
-    std::size_t n = 0;
-    for (const auto s : static_cells)
-      n += s;
-    return n;
-  }
-};
+using namespace dynvo::test;
 
 template <typename PointT> class StaticSceneRegistrationTyped : public ::testing::Test {
 };
@@ -93,24 +33,24 @@ TYPED_TEST(StaticSceneRegistrationTyped, SameFrameTwiceGivesIdentity)
   dynvo::StaticSceneRegistration<TypeParam> registration;
   registration.setInputSource(pair.current.cloud);
   registration.setInputTarget(pair.current.cloud);
-  registration.setIndices(pair.staticPixels(scene.width));
+  registration.setIndices(pair.staticPixels());
   registration.setInputFlow(pair.flow);
   pcl::PointCloud<TypeParam> aligned;
   registration.align(aligned);
   ASSERT_TRUE(registration.hasConverged());
   EXPECT_EQ(registration.getStatus(), StaticRegistrationStatus::converged);
-  EXPECT_LT(rotationErrorDeg(registration.getFinalTransformation(),
-                             Eigen::Matrix4d::Identity()),
-            ROTATION_TOL);
+  EXPECT_LT(
+      rotationError(registration.getFinalTransformation(), Eigen::Matrix4d::Identity()),
+      ROTATION_TOL);
   EXPECT_LT(translationError(registration.getFinalTransformation(),
                              Eigen::Matrix4d::Identity()),
             TRANSLATION_TOL);
   EXPECT_EQ(registration.getNumberOfCorrespondences(), pair.staticCellCount());
   EXPECT_EQ(registration.getNumberOfInliers(), pair.staticCellCount());
   // Residuals are float round-off only: (1e-5 m)^2 bounds it with a wide margin.
-  EXPECT_LT(registration.getFitnessScore(), 1e-10);
+  EXPECT_LT(registration.getMeanSquaredResidual(), 1e-10);
   // align() returns the static points, unorganized (PCL's rule once indices are set).
-  EXPECT_EQ(aligned.size(), pair.staticPixels(scene.width)->indices.size());
+  EXPECT_EQ(aligned.size(), pair.staticPixels()->indices.size());
   EXPECT_EQ(aligned.height, 1u);
 }
 
@@ -122,17 +62,14 @@ TYPED_TEST(StaticSceneRegistrationTyped, RecoversAKnownMotionForwardAndInverse)
       scene.T_curr_prev = scene.T_curr_prev.inverse();
     const FramePair<TypeParam> pair(scene);
     dynvo::StaticSceneRegistration<TypeParam> registration;
-    registration.setInputSource(pair.current.cloud);
-    registration.setInputTarget(pair.previous.cloud);
-    registration.setIndices(pair.staticPixels(scene.width));
-    registration.setInputFlow(pair.flow);
+    pair.feed(registration);
+    registration.setIndices(pair.staticPixels());
     pcl::PointCloud<TypeParam> aligned;
     registration.align(aligned);
     ASSERT_TRUE(registration.hasConverged()) << "inverse " << inverse;
     // getFinalTransformation() is T_prev_curr, the inverse of the paper's H_k = T_curr_prev.
     const Eigen::Matrix4d truth = scene.T_curr_prev.inverse().matrix();
-    EXPECT_LT(rotationErrorDeg(registration.getFinalTransformation(), truth),
-              ROTATION_TOL)
+    EXPECT_LT(rotationError(registration.getFinalTransformation(), truth), ROTATION_TOL)
         << "inverse " << inverse;
     EXPECT_LT(translationError(registration.getFinalTransformation(), truth),
               TRANSLATION_TOL)
@@ -140,7 +77,7 @@ TYPED_TEST(StaticSceneRegistrationTyped, RecoversAKnownMotionForwardAndInverse)
     // The moving box's cells were never selected, so nothing was trimmed.
     EXPECT_EQ(registration.getNumberOfInliers(), pair.staticCellCount());
     // Exact correspondences: the mean squared residual is round-off, below (10 um)^2.
-    EXPECT_LT(registration.getFitnessScore(), 1e-10) << "inverse " << inverse;
+    EXPECT_LT(registration.getMeanSquaredResidual(), 1e-10) << "inverse " << inverse;
   }
 }
 
@@ -157,10 +94,8 @@ TYPED_TEST(StaticSceneRegistrationTyped, TooFewStaticCellsDoNotConverge)
       ++kept;
     }
   dynvo::StaticSceneRegistration<TypeParam> registration;
-  registration.setInputSource(pair.current.cloud);
-  registration.setInputTarget(pair.previous.cloud);
-  registration.setIndices(cellPixels(few, pair.cols, CELL, scene.width));
-  registration.setInputFlow(pair.flow);
+  pair.feed(registration);
+  registration.setIndices(pair.pixels(few));
   Eigen::Matrix4f prediction = Eigen::Matrix4f::Identity();
   prediction(0, 3) = 0.25f;
   pcl::PointCloud<TypeParam> aligned;
@@ -170,7 +105,7 @@ TYPED_TEST(StaticSceneRegistrationTyped, TooFewStaticCellsDoNotConverge)
             StaticRegistrationStatus::too_few_correspondences);
   EXPECT_EQ(registration.getNumberOfCorrespondences(), 5u);
   EXPECT_EQ(registration.getFinalTransformation(), prediction);
-  EXPECT_EQ(registration.getFitnessScore(), std::numeric_limits<double>::max());
+  EXPECT_EQ(registration.getMeanSquaredResidual(), std::numeric_limits<double>::max());
   EXPECT_TRUE(aligned.empty());
   // Lowering the minimum to 5 turns the same input into a converged estimate.
   registration.setMinCorrespondences(5);
@@ -186,10 +121,8 @@ protected:
       : scene_(BoxScene::make())
       , pair_(scene_)
   {
-    registration_.setInputSource(pair_.current.cloud);
-    registration_.setInputTarget(pair_.previous.cloud);
-    registration_.setIndices(pair_.staticPixels(scene_.width));
-    registration_.setInputFlow(pair_.flow);
+    pair_.feed(registration_);
+    registration_.setIndices(pair_.staticPixels());
   }
 
   Eigen::Matrix4d truth() const { return scene_.T_curr_prev.inverse().matrix(); }
@@ -213,9 +146,7 @@ TEST_F(StaticSceneRegistrationTest, CellCentresAndWholeCellsSelectTheSameCells)
   pcl::PointIndices::Ptr centres(new pcl::PointIndices);
   for (std::size_t i = 0; i < pair_.static_cells.size(); ++i)
     if (pair_.static_cells[i]) {
-      const std::uint32_t u = (i % pair_.cols) * CELL + CELL / 2;
-      const std::uint32_t v = (i / pair_.cols) * CELL + CELL / 2;
-      centres->indices.push_back(static_cast<int>(v * scene_.width + u));
+      centres->indices.push_back(static_cast<int>(pair_.grid.centreIndex(i)));
     }
   registration_.setIndices(centres);
   registration_.align(aligned_);
@@ -224,6 +155,39 @@ TEST_F(StaticSceneRegistrationTest, CellCentresAndWholeCellsSelectTheSameCells)
   EXPECT_LT(translationError(registration_.getFinalTransformation(), truth()),
             TRANSLATION_TOL);
   EXPECT_EQ(aligned_.size(), centres->indices.size());
+}
+
+TEST_F(StaticSceneRegistrationTest, StaticCellsSelectWhatTheirPixelsSelect)
+{
+  registration_.align(aligned_);
+  ASSERT_TRUE(registration_.hasConverged());
+  const Eigen::Matrix4f by_pixels = registration_.getFinalTransformation();
+  // Cells take precedence: the indices now name a single pixel, which alone is too few.
+  pcl::PointIndices::Ptr one(new pcl::PointIndices);
+  one->indices = {0};
+  registration_.setIndices(one);
+  registration_.setStaticCells(pair_.cells(pair_.static_cells));
+  registration_.align(aligned_);
+  ASSERT_TRUE(registration_.hasConverged());
+  EXPECT_EQ(registration_.getNumberOfCorrespondences(), pair_.staticCellCount());
+  // The same cells in the same order: the same fit, bit for bit.
+  EXPECT_EQ(registration_.getFinalTransformation(), by_pixels);
+  // The output: the centres of the static cells, moved.
+  EXPECT_EQ(aligned_.size(), pair_.staticCellCount());
+
+  registration_.setStaticCells(dynvo::FlowGrid());
+  registration_.align(aligned_);
+  EXPECT_EQ(registration_.getStatus(),
+            StaticRegistrationStatus::too_few_correspondences);
+}
+
+TEST_F(StaticSceneRegistrationTest, StaticCellsOnAnotherGridAreRejected)
+{
+  registration_.setStaticCells(dynvo::FlowGrid(scene_.width, scene_.height, CELL / 2));
+  const std::string log = alignCapturingErrors();
+  EXPECT_NE(log.find("not on the flow's grid"), std::string::npos) << log;
+  EXPECT_FALSE(registration_.hasConverged());
+  EXPECT_EQ(registration_.getStatus(), StaticRegistrationStatus::invalid_input);
 }
 
 TEST_F(StaticSceneRegistrationTest, WithoutIndicesEveryValidCellCounts)
@@ -261,13 +225,13 @@ TEST_F(StaticSceneRegistrationTest, OutliersInTheStaticSetAreTrimmed)
   registration_.setTrimRounds(2);
   registration_.align(aligned_);
   ASSERT_TRUE(registration_.hasConverged());
-  EXPECT_LT(rotationErrorDeg(registration_.getFinalTransformation(), truth()),
+  EXPECT_LT(rotationError(registration_.getFinalTransformation(), truth()),
             ROTATION_TOL);
   EXPECT_LT(translationError(registration_.getFinalTransformation(), truth()),
             TRANSLATION_TOL);
   EXPECT_EQ(registration_.getNumberOfInliers(), pair_.staticCellCount() - 5);
   // The kept cells are exact, so the fitness is round-off, below (10 um)^2.
-  EXPECT_LT(registration_.getFitnessScore(), 1e-10);
+  EXPECT_LT(registration_.getMeanSquaredResidual(), 1e-10);
 }
 
 TEST_F(StaticSceneRegistrationTest, CollinearStaticCellsAreDegenerate)
@@ -276,15 +240,15 @@ TEST_F(StaticSceneRegistrationTest, CollinearStaticCellsAreDegenerate)
   // wall with the viewing plane of that image row, a straight line.
   std::vector<std::uint8_t> row(pair_.static_cells.size(), 0);
   std::size_t n = 0;
-  for (std::uint32_t col = 0; col < pair_.cols; ++col) {
+  for (std::uint32_t col = 0; col < pair_.grid.cols; ++col) {
     const std::uint32_t u = col * CELL + CELL / 2;
-    if (pair_.current.box[CELL / 2 * scene_.width + u] == 0) { // box 0 = back wall
+    if (pair_.current.ids[CELL / 2 * scene_.width + u] == 0) { // box 0 = back wall
       row[col] = 1;
       ++n;
     }
   }
   ASSERT_GE(n, 6u);
-  registration_.setIndices(cellPixels(row, pair_.cols, CELL, scene_.width));
+  registration_.setIndices(pair_.pixels(row));
   registration_.align(aligned_);
   EXPECT_FALSE(registration_.hasConverged());
   EXPECT_EQ(registration_.getStatus(), StaticRegistrationStatus::degenerate);
@@ -308,10 +272,11 @@ TEST_P(RefinementTest, ConvergesFromASlightlyWrongFlowEstimate)
   registration_.setInputTarget(pair_.previous.cloud);
   BoxScene biased = scene_;
   biased.T_curr_prev =
-      dynvo::test::rigid({1.0, -0.5, 0.3}, 0.5, {0.01, 0.0, 0.0}) * scene_.T_curr_prev;
+      dynvo::test::makePose({1.0, -0.5, 0.3}, radians(0.5), {0.01, 0.0, 0.0}) *
+      scene_.T_curr_prev;
   std::vector<std::uint8_t> unused;
   registration_.setInputFlow(pcl::make_shared<pcl::PointCloud<dynvo::PointFlow>>(
-      biased.flow(pair_.current, CELL, unused)));
+      biased.flow(pair_.current, unused)));
   registration_.setIndices(pair_.staticSurfacePixels(scene_));
   registration_.setRefinement(GetParam());
   registration_.setRefinementStride(2);
@@ -321,7 +286,7 @@ TEST_P(RefinementTest, ConvergesFromASlightlyWrongFlowEstimate)
   const Eigen::Matrix4f& flow_estimate = registration_.getFlowTransformation();
   const Eigen::Matrix4f& refined = registration_.getFinalTransformation();
   EXPECT_GT(translationError(flow_estimate, truth()), 5e-3);
-  EXPECT_GT(rotationErrorDeg(flow_estimate, truth()), 0.3);
+  EXPECT_GT(rotationError(flow_estimate, truth()), radians(0.3));
   // State tolerance. GICP matches local planes, so the different sampling of the two frames
   // cancels: 1 mm / 0.05 degrees as for the flow estimate (measured 0.3 mm / 0.02 degrees).
   // Point-to-point ICP pairs each sample with the nearest sample of the other frame, 1.3-2 cm
@@ -329,7 +294,7 @@ TEST_P(RefinementTest, ConvergesFromASlightlyWrongFlowEstimate)
   // (measured 3.4 mm / 0.39 degrees): it must at least halve the 1 cm error and reduce the rotation error.
   const bool gicp = GetParam() == dynvo::RegistrationRefinement::gicp;
   EXPECT_LT(translationError(refined, truth()), gicp ? TRANSLATION_TOL : 5e-3);
-  EXPECT_LT(rotationErrorDeg(refined, truth()), gicp ? ROTATION_TOL : 0.45);
+  EXPECT_LT(rotationError(refined, truth()), gicp ? ROTATION_TOL : radians(0.45));
 }
 
 INSTANTIATE_TEST_SUITE_P(IcpAndGicp,
@@ -346,13 +311,14 @@ TEST_F(StaticSceneRegistrationTest, MissingInputsAreLoggedAndNotConverged)
   registration_.align(aligned_);
   ASSERT_TRUE(registration_.hasConverged()); // a good run first: nothing may stay stale
 
+  // No source or target: pcl::Registration::align() reports it and computes nothing.
   dynvo::StaticSceneRegistration<Point> empty;
   ::testing::internal::CaptureStderr();
   empty.align(aligned_);
-  EXPECT_NE(::testing::internal::GetCapturedStderr().find(PREFIX), std::string::npos);
+  EXPECT_NE(::testing::internal::GetCapturedStderr().find("StaticSceneRegistration"),
+            std::string::npos);
   EXPECT_FALSE(empty.hasConverged());
-  EXPECT_EQ(empty.getStatus(), StaticRegistrationStatus::invalid_input);
-  EXPECT_TRUE(aligned_.empty());
+  EXPECT_EQ(empty.getStatus(), StaticRegistrationStatus::not_computed);
 
   registration_.setInputFlow(nullptr);
   const std::string log = alignCapturingErrors();
@@ -372,7 +338,8 @@ TEST_F(StaticSceneRegistrationTest, MissingInputsAreLoggedAndNotConverged)
   ::testing::internal::CaptureStderr();
   no_target.align(aligned_);
   const std::string target_log = ::testing::internal::GetCapturedStderr();
-  EXPECT_NE(target_log.find(PREFIX), std::string::npos) << target_log;
+  EXPECT_NE(target_log.find("StaticSceneRegistration"), std::string::npos)
+      << target_log;
   EXPECT_NE(target_log.find("target"), std::string::npos) << target_log;
   EXPECT_FALSE(no_target.hasConverged());
 }
@@ -414,15 +381,82 @@ TEST_F(StaticSceneRegistrationTest, MismatchedSizesAndBadIndicesAreRejected)
   EXPECT_NE(alignCapturingErrors().find(PREFIX), std::string::npos);
   EXPECT_FALSE(registration_.hasConverged());
 
+  // Bad indices are rejected when set, before pcl::Registration::align() could copy them,
+  // and reported again by align().
   registration_.setInputFlow(pair_.flow);
   pcl::PointIndices::Ptr bad(new pcl::PointIndices);
   bad->indices = {0, static_cast<int>(pair_.current.cloud->size())};
+  ::testing::internal::CaptureStderr();
   registration_.setIndices(bad);
+  EXPECT_NE(::testing::internal::GetCapturedStderr().find(
+                "[dynvo::StaticSceneRegistration::setIndices]"),
+            std::string::npos);
   EXPECT_NE(alignCapturingErrors().find(PREFIX), std::string::npos);
   EXPECT_FALSE(registration_.hasConverged());
+  EXPECT_EQ(registration_.getStatus(), StaticRegistrationStatus::invalid_input);
   bad->indices = {-1};
+  ::testing::internal::CaptureStderr();
+  registration_.setIndices(bad);
+  ::testing::internal::GetCapturedStderr();
   EXPECT_NE(alignCapturingErrors().find(PREFIX), std::string::npos);
   EXPECT_FALSE(registration_.hasConverged());
+  // Rejected indices select nothing; the source they were meant for takes them back.
+  EXPECT_TRUE(registration_.getIndices()->empty());
+  bad->indices = {0, static_cast<int>(pair_.current.cloud->size())};
+  ::testing::internal::CaptureStderr();
+  registration_.setIndices(bad);
+  ::testing::internal::GetCapturedStderr();
+  registration_.setInputSource(BoxScene::make(320, 240).render<Point>(true).cloud);
+  EXPECT_EQ(registration_.getIndices()->size(), 2u);
+}
+
+TEST(StaticSceneRegistrationAsPcl, WorksThroughAPclRegistrationPointer)
+{
+  // Everything but the flow goes through pcl::Registration: inputs, indices, knobs, align()
+  // and PCL's fitness score.
+  const BoxScene scene = BoxScene::make();
+  const FramePair<Point> pair(scene);
+  auto registration = pcl::make_shared<dynvo::StaticSceneRegistration<Point>>();
+  registration->setInputFlow(pair.flow);
+  pcl::Registration<Point, Point, float>* base = registration.get();
+  base->setInputSource(pair.current.cloud);
+  base->setInputTarget(pair.previous.cloud);
+  base->setIndices(pair.staticPixels());
+  base->setMaximumIterations(12);
+  base->setMaxCorrespondenceDistance(0.02);
+  base->setTransformationEpsilon(1e-9);
+  // The base's knobs are the refinement's.
+  const dynvo::StaticSceneRegistrationParameters parameters =
+      registration->getParameters();
+  EXPECT_EQ(parameters.refinement_max_iterations, 12);
+  EXPECT_EQ(parameters.refinement_max_correspondence_distance, 0.02);
+  EXPECT_EQ(parameters.refinement_transformation_epsilon, 1e-9);
+  dynvo::StaticSceneRegistrationParameters defaults;
+  registration->setParameters(defaults);
+  EXPECT_EQ(base->getMaximumIterations(), defaults.refinement_max_iterations);
+  EXPECT_EQ(base->getMaxCorrespondenceDistance(),
+            defaults.refinement_max_correspondence_distance);
+  EXPECT_EQ(base->getTransformationEpsilon(),
+            defaults.refinement_transformation_epsilon);
+
+  pcl::PointCloud<Point> aligned;
+  base->align(aligned);
+  ASSERT_TRUE(base->hasConverged());
+  const Eigen::Matrix4d truth = scene.T_curr_prev.inverse().matrix();
+  EXPECT_LT(translationError(base->getFinalTransformation(), truth), TRANSLATION_TOL);
+  EXPECT_LT(rotationError(base->getFinalTransformation(), truth), ROTATION_TOL);
+  EXPECT_EQ(aligned.size(), pair.staticPixels()->indices.size());
+  // PCL's fitness: nearest target points of the moved source. The exact static points land
+  // on the same surfaces, between target samples at most a pixel apart (<= 3 cm at 3.5 m and
+  // 160x120), so the mean squared distance stays below (3 cm)^2; the moving box's points,
+  // 13 cm away from where they were, are left out by a 5 cm max_range.
+  const double fitness = base->getFitnessScore(0.05 * 0.05);
+  EXPECT_GT(fitness, 0.0);
+  EXPECT_LT(fitness, 0.03 * 0.03);
+
+  // Knobs set through the base are checked when used.
+  base->setMaximumIterations(0);
+  EXPECT_THROW(base->align(aligned), std::invalid_argument);
 }
 
 TEST_F(StaticSceneRegistrationTest, CallsThroughThePclBaseAreCheckedToo)
@@ -458,11 +492,15 @@ TEST(StaticSceneRegistrationParameters, DefaultsFollowTheAlgorithmAndBadValuesTh
   EXPECT_THROW(
       registration.setRefinement(static_cast<dynvo::RegistrationRefinement>(7)),
       std::invalid_argument);
-  EXPECT_THROW(registration.setRefinementMaxCorrespondenceDistance(0.0),
-               std::invalid_argument);
-  EXPECT_THROW(registration.setRefinementMaxIterations(0), std::invalid_argument);
-  EXPECT_THROW(registration.setRefinementTransformationEpsilon(-1.0),
-               std::invalid_argument);
+  dynvo::StaticSceneRegistrationParameters bad;
+  bad.refinement_max_correspondence_distance = 0.0;
+  EXPECT_THROW(registration.setParameters(bad), std::invalid_argument);
+  bad = defaults;
+  bad.refinement_max_iterations = 0;
+  EXPECT_THROW(registration.setParameters(bad), std::invalid_argument);
+  bad = defaults;
+  bad.refinement_transformation_epsilon = -1.0;
+  EXPECT_THROW(registration.setParameters(bad), std::invalid_argument);
   EXPECT_THROW(registration.setRefinementStride(0), std::invalid_argument);
   // A rejected value leaves the previous one in place.
   EXPECT_FLOAT_EQ(registration.getInlierThreshold(), 3e-5f);
@@ -484,16 +522,13 @@ TEST(StaticSceneRegistrationVga, VgaFramesWorkAndAMismatchedGridIsRejected)
   EXPECT_EQ(pair.flow->width, 40u);
   EXPECT_EQ(pair.flow->height, 30u);
   dynvo::StaticSceneRegistration<pcl::PointXYZRGBA> registration;
-  registration.setInputSource(pair.current.cloud);
-  registration.setInputTarget(pair.previous.cloud);
-  registration.setIndices(pair.staticPixels(scene.width));
-  registration.setInputFlow(pair.flow);
+  pair.feed(registration);
+  registration.setIndices(pair.staticPixels());
   pcl::PointCloud<pcl::PointXYZRGBA> aligned;
   registration.align(aligned);
   ASSERT_TRUE(registration.hasConverged());
   const Eigen::Matrix4d truth = scene.T_curr_prev.inverse().matrix();
-  EXPECT_LT(rotationErrorDeg(registration.getFinalTransformation(), truth),
-            ROTATION_TOL);
+  EXPECT_LT(rotationError(registration.getFinalTransformation(), truth), ROTATION_TOL);
   EXPECT_LT(translationError(registration.getFinalTransformation(), truth),
             TRANSLATION_TOL);
   EXPECT_EQ(registration.getNumberOfCorrespondences(), pair.staticCellCount());

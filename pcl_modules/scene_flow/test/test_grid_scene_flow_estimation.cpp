@@ -394,6 +394,11 @@ TEST_F(GridSceneFlowContractTest,
   estimation_.setCellSize(40); // larger than the 32x32 image
   EXPECT_NE(computeCapturingErrors().find("no 40 px grid cell"), std::string::npos);
   EXPECT_TRUE(flow_.empty());
+
+  // 12 px cells on 32 px: 2 columns, from which the consumers would infer 16 px cells.
+  estimation_.setCellSize(12);
+  EXPECT_NE(computeCapturingErrors().find("could not be inferred"), std::string::npos);
+  EXPECT_TRUE(flow_.empty());
 }
 
 TEST_F(GridSceneFlowContractTest, VgaPairGivesAFortyByThirtyGridOnCellCentres)

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <dynvo/common/export.h>
+#include <dynvo/common/flow_grid.h>
 #include <dynvo/common/point_types.h>
 #include <dynvo/common/sensor_noise_model.h>
 
@@ -22,10 +23,7 @@ namespace dynvo {
  * segmentation and tracking math compiles once, independent of the point type.
  */
 struct DYNVO_EXPORTS GridFlowData {
-  int cols = 0; ///< Gx, grid columns
-  int rows = 0; ///< Gy, grid rows
-  int cell_size =
-      16; ///< w_grid (px); cell (col, row) is centred on (col, row) * w_grid + w_grid / 2
+  FlowGrid geometry; ///< cells, cell size and image size (its labels are unused)
   std::vector<std::uint8_t> valid_2d; ///< 1 when the 2D track p_i is valid
   std::vector<std::uint8_t> valid_3d; ///< 1 when a_i and b_i are valid
   std::vector<Eigen::Vector2f>
@@ -41,20 +39,23 @@ struct DYNVO_EXPORTS GridFlowData {
   /// Number of cells.
   std::size_t size() const { return valid_3d.size(); }
 
+  /// Gx, grid columns.
+  int cols() const { return static_cast<int>(geometry.cols); }
+
+  /// Gy, grid rows.
+  int rows() const { return static_cast<int>(geometry.rows); }
+
+  /// w_grid (px).
+  int cellSize() const { return static_cast<int>(geometry.cell_size); }
+
   /// Centre c_i of cell i (px, current image).
-  Eigen::Vector2f cellCentre(std::size_t i) const
-  {
-    const int col = static_cast<int>(i % static_cast<std::size_t>(cols));
-    const int row = static_cast<int>(i / static_cast<std::size_t>(cols));
-    return {static_cast<float>(col * cell_size + cell_size / 2),
-            static_cast<float>(row * cell_size + cell_size / 2)};
-  }
+  Eigen::Vector2f cellCentre(std::size_t i) const { return geometry.centre(i); }
 
   /** \brief Copies an organized flow grid.
-   * \param[in] flow organized cols x rows cloud as computed by GridSceneFlowEstimation
-   * \param[in] cell_size w_grid (px) the flow was computed with
+   * \param[in] flow organized cloud as computed by GridSceneFlowEstimation
+   * \param[in] grid its geometry (FlowGrid::fromFlow()); only the geometry is kept
    */
-  void assign(const pcl::PointCloud<PointFlow>& flow, int cell_size);
+  void assign(const pcl::PointCloud<PointFlow>& flow, const FlowGrid& grid);
 
   /// E_i of cell i under the motion (R, t) mapping a_i to b_i: ||R a_i + t - b_i||^2, or
   /// e^T W_i e with the information matrices (docs/algorithm.md §2).

@@ -5,6 +5,7 @@
 #include <dynvo/common/camera.h>
 #include <dynvo/common/conventions.h>
 #include <dynvo/common/export.h>
+#include <dynvo/common/flow_grid.h>
 #include <dynvo/common/point_types.h>
 #include <dynvo/motion_segmentation/grid_flow_data.h>
 #include <dynvo/motion_segmentation/rigid_motion_segmentation_parameters.h>
@@ -76,7 +77,8 @@ public:
   /// Current frame k (organized, metres); the pixel indices of segment() refer to it.
   void setInputCloud(const PointCloudConstPtr& cloud) override;
 
-  /// Grid scene flow from frame k-1 to frame k (organized, (width / w_grid) x (height / w_grid)).
+  /// Grid scene flow from frame k-1 to frame k (organized, (width / w_grid) x (height / w_grid));
+  /// the cell size w_grid is inferred from it (FlowGrid::fromFlow()).
   void setInputFlow(const FlowCloudConstPtr& flow);
 
   const FlowCloudConstPtr& getInputFlow() const { return flow_; }
@@ -97,7 +99,11 @@ public:
   const Motions& getMotions() const { return motions_; }
 
   /// Output label per grid cell (row-major, cols x rows of the flow): 0 none, 1 static, 2.. objects.
-  const std::vector<std::uint8_t>& getCellLabels() const { return cell_labels_; }
+  const std::vector<std::uint8_t>& getCellLabels() const { return cell_grid_.labels; }
+
+  /// The grid of the last segment() with the output label of each cell (getCellLabels());
+  /// empty when the inputs broke the contract.
+  const FlowGrid& getCellGrid() const { return cell_grid_; }
 
   /// The two-frame segmentation of the last segment() (G, one motion per segment, docs/algorithm.md §3).
   const SpatialSegmentationResult& getSpatialSegmentation() const { return spatial_; }
@@ -144,7 +150,6 @@ public:
   // table()) and keeps the old value; the rules tying two fields (max_trials >=
   // max_hypotheses, object_separation_hold <= object_separation_ratio) are checked by
   // segment(), so the setters may come in any order.
-  DYNVO_PARAMETER_ACCESSORS(CellSize, cell_size)
   DYNVO_PARAMETER_ACCESSORS(MaxHypotheses, max_hypotheses)
   DYNVO_PARAMETER_ACCESSORS(MaxTrials, max_trials)
   DYNVO_PARAMETER_ACCESSORS(SampleSize, sample_size)
@@ -176,8 +181,9 @@ protected:
   /// Non-null, organized input cloud and flow; logs PCL_ERROR and returns false otherwise.
   bool initCompute();
 
-  /// The flow grid is (width / w_grid) x (height / w_grid); logs PCL_ERROR otherwise.
-  bool validateInputs() const;
+  /// The flow grid is the (width / w_grid) x (height / w_grid) grid of a cell size w_grid
+  /// (FlowGrid::fromFlow()); sets the geometry of cell_grid_, logs PCL_ERROR otherwise.
+  bool validateInputs();
 
   /// Fills segments with the pixels of each labelled cell, in segment_labels_ order.
   void computeImplIndices(std::vector<pcl::PointIndices>& segments) const;
@@ -209,7 +215,7 @@ private:
   SpatialSegmenter segmenter_;               ///< §3 with its scratch buffers
   SpatialSegmentationResult spatial_;        ///< §3 result of the last frame
   SegmentTracker tracker_;                   ///< §4-§6 state across frames
-  std::vector<std::uint8_t> cell_labels_;    ///< output label per cell
+  FlowGrid cell_grid_;                       ///< geometry and output label per cell
   std::vector<std::uint8_t> segment_labels_; ///< id of each output segment
   Motions motions_;                          ///< T_curr_prev of each output segment
   /// s_axial, s_lateral: the sensor model's gains on its axial and lateral sigma, fitted

@@ -23,8 +23,6 @@ enum class ResidualModel {
  * each field.
  */
 struct DYNVO_EXPORTS RigidMotionSegmentationParameters {
-  /// w_grid (px, >= 2): must equal the scene flow's cell size
-  int cell_size = 16;
   /// h_max (1..254): accepted hypotheses per frame
   int max_hypotheses = 20;
   /// T_max (>= max_hypotheses): trials per frame, failed ones included

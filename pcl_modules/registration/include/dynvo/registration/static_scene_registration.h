@@ -4,7 +4,9 @@
 #pragma once
 
 #include <dynvo/common/export.h>
+#include <dynvo/common/flow_grid.h>
 #include <dynvo/common/point_types.h>
+#include <dynvo/registration/lazy_kd_tree.h>
 #include <dynvo/registration/static_scene_registration_parameters.h>
 
 #include <pcl/point_cloud.h>
@@ -41,42 +43,56 @@ enum class StaticRegistrationStatus {
  *
  * Flow estimate (no nearest-neighbour search): the flow grid (setInputFlow, from
  * GridSceneFlowEstimation on the same frame pair) gives per cell b_i (x, y, z; current frame)
- * and a_i (prev_x, prev_y, prev_z; previous frame). Cell geometry: cell_size = width / flow.width
- * (integer division), and height / cell_size must equal flow.height. A static pixel (col, row)
- * selects the cell (col / cell_size, row / cell_size); pixels right of or below the last full
- * cell select none, and a cell counts once however many of its pixels are listed (cell centres
- * alone or whole cells both work). Without setIndices() every cell counts as static. The set S
+ * and a_i (prev_x, prev_y, prev_z; previous frame); the cell geometry is inferred from it
+ * (FlowGrid::fromFlow()). The static cells come as cells (setStaticCells(): the cells labelled
+ * LABEL_STATIC, e.g. from StaticSetSelection) or, PCL's way, as pixels (setIndices()): a pixel
+ * selects the cell holding it (FlowGrid::cellOfPixel(); pixels right of or below the last full
+ * cell select none), and a cell counts once however many of its pixels are listed. Static cells,
+ * when set, take precedence over indices; with neither, every cell counts as static. The set S
  * holds the selected cells with valid_3d, finite a_i and b_i and weight > 0. The weighted
  * least-squares rigid fit (RigidFitAccumulator, weights = flow weights) maps b_i onto a_i; then
  * trim_rounds rounds keep the cells of S with E_i <= trim_factor * th_inlier and refit; a round
  * leaving fewer than min_correspondences cells, or a degenerate refit, keeps the previous fit.
  *
- * Refinement (optional): ICP or GICP on plain XYZ copies of the static points of the source
- * (every refinement_stride-th row and column) against the finite points of the whole target on
+ * Refinement (optional): ICP or GICP on plain XYZ copies of the finite static source points
+ * (the pixels of the static cells, or else the listed indices; every refinement_stride-th row
+ * and column) against the finite points of the whole target on
  * the same lattice, initialised with the flow estimate. Moving objects in the previous frame are
- * kept out only by refinement_max_correspondence_distance.
+ * kept out only by the maximum correspondence distance. pcl::Registration's knobs are the
+ * refinement's: setMaximumIterations(), setMaxCorrespondenceDistance() and
+ * setTransformationEpsilon() are refinement_max_iterations,
+ * refinement_max_correspondence_distance and refinement_transformation_epsilon of
+ * Parameters (setParameters() sets them, getParameters() reads them back). Correspondence
+ * estimation and rejectors are not used: the flow gives the correspondences.
  *
  * Results: hasConverged() is false for invalid input, too few cells (|S| < min_correspondences)
  * and degenerate cells; getStatus() says which, and getFinalTransformation() is then the guess
  * passed to align() (identity by default), so a pipeline can pass its constant-velocity
- * prediction and flag the frame as lost. getFitnessScore() is the mean squared residual E_i (m^2)
- * of the kept cells under the final transformation (also after refinement).
+ * prediction and flag the frame as lost. getMeanSquaredResidual() is the mean squared
+ * residual E_i (m^2) of the kept cells under the final transformation (also after refinement);
+ * getFitnessScore(max_range) keeps PCL's meaning (mean squared distance of the source points to
+ * their nearest target points, on a kd-tree built on the first call only).
  * getNumberOfCorrespondences() is |S|, getNumberOfInliers() the number of kept cells.
- * The output cloud of align() holds the static points transformed into the previous frame; it is
- * unorganized once indices are set (PCL's registration.hpp) and empty when not converged.
+ * The output cloud of align() holds the source points at the centres of the static cells, or
+ * else those of setIndices() (all of them without), transformed into the previous frame; it is
+ * unorganized once indices or cells are set (PCL's registration.hpp) and empty when not
+ * converged. With static cells, getIndices() is those centres.
  *
- * pcl::Registration's own knobs (setMaximumIterations, setMaxCorrespondenceDistance, the
- * correspondence estimation and rejectors) are not used: see Parameters. No kd-tree is ever
- * built, so call getFitnessScore() on this class; the base's getFitnessScore(max_range) would
- * search an empty tree. Call align() on this class too: the base's align() skips the dynvo
- * input checks and does not range-check the indices.
+ * Only computeTransformation() is overridden, so align() works the same through a
+ * pcl::Registration pointer. A missing source or target is pcl::Registration's to report
+ * (its PCL_ERROR, no result); the other inputs are checked by computeTransformation()
+ * (validateInputs()). Indices are
+ * range-checked when they or the source are set, before pcl::Registration::align() copies the
+ * indexed points: an out-of-range index is logged with PCL_ERROR there and again by the next
+ * align(), which does not converge (the rejected indices select nothing). Indices changed
+ * through a kept pointer after setIndices() are not checked again, as in any pcl::Registration.
  * \code
  * dynvo::StaticSceneRegistration<pcl::PointXYZRGB> registration;
  * registration.setInputSource(current);               // frame k
  * registration.setInputTarget(previous);              // frame k-1
- * registration.setIndices(static_indices);            // e.g. segments[0] of the segmentation
  * registration.setInputFlow(flow);                    // grid scene flow k-1 -> k
- * pcl::PointCloud<pcl::PointXYZRGB> aligned;
+ * registration.setStaticCells(static_cells);          // e.g. from StaticSetSelection
+ * pcl::PointCloud<pcl::PointXYZRGB> aligned;           // pcl::Registration::align:
  * registration.align(aligned, T_prev_curr_predicted); // the guess is returned when not converged
  * if (registration.hasConverged()) T_world_curr = T_world_prev * registration.getFinalTransformation();
  * \endcode
@@ -99,26 +115,55 @@ public:
   using Refinement = RegistrationRefinement;
   using Status = StaticRegistrationStatus;
 
-  /// Sets the class name and disables the base class's kd-tree on the target.
+  /// Sets the class name, the lazily built target kd-tree and the default parameters.
   StaticSceneRegistration();
+
+  using Base::setIndices;
+
+  // Static pixels, PCL's way (see the class doc), range-checked against the source.
+  void setIndices(const pcl::IndicesPtr& indices) override
+  {
+    Base::setIndices(indices);
+    adoptIndices();
+  }
+  void setIndices(const pcl::IndicesConstPtr& indices) override
+  {
+    Base::setIndices(indices);
+    adoptIndices();
+  }
+  void setIndices(const pcl::PointIndicesConstPtr& indices) override
+  {
+    Base::setIndices(indices);
+    adoptIndices();
+  }
+  void setIndices(std::size_t row_start,
+                  std::size_t col_start,
+                  std::size_t nb_rows,
+                  std::size_t nb_cols) override
+  {
+    Base::setIndices(row_start, col_start, nb_rows, nb_cols);
+    adoptIndices();
+  }
+
+  /// Frame k (organized, metres); the indices are range-checked against it.
+  void setInputSource(const PointCloudConstPtr& cloud) override;
 
   /// Grid scene flow from the target (frame k-1) to the source (frame k), organized Gx x Gy.
   void setInputFlow(const FlowCloudConstPtr& flow) { flow_ = flow; }
 
   const FlowCloudConstPtr& getInputFlow() const { return flow_; }
 
-  /// Estimates T_prev_curr; see the class doc. \param[out] output static points, moved
-  void align(PointCloud& output) { align(output, Matrix4::Identity()); }
-
-  /** \brief Estimates T_prev_curr; see the class doc.
-   * \param[out] output static points of the source moved into the target frame (unorganized)
-   * \param[in] guess T_prev_curr returned by getFinalTransformation() when not converged
+  /** \brief The static set as cells: those labelled LABEL_STATIC. Its geometry must be the
+   * flow's on the source cloud (checked by align()); takes precedence over setIndices(). An
+   * empty grid (FlowGrid()) removes it.
    */
-  void align(PointCloud& output, const Matrix4& guess);
+  void setStaticCells(const FlowGrid& cells);
+
+  const FlowGrid& getStaticCells() const { return static_cells_input_; }
 
   /// Mean squared residual E_i (m^2) of the kept cells under the final transformation;
   /// std::numeric_limits<double>::max() when not converged.
-  double getFitnessScore() const { return fitness_; }
+  double getMeanSquaredResidual() const { return mean_squared_residual_; }
 
   /// |S|: usable static cells of the last align() (0 for invalid input).
   std::size_t getNumberOfCorrespondences() const { return source_points_.size(); }
@@ -131,46 +176,56 @@ public:
   /// T_prev_curr of the trimmed flow estimate, before any refinement (the guess when it failed).
   const Matrix4& getFlowTransformation() const { return flow_transformation_; }
 
-  /// All knobs at once. \throws std::invalid_argument when parameters.validate() fails
-  void setParameters(const Parameters& parameters)
-  {
-    parameters.validate();
-    assignParameters(parameters);
-  }
+  /** \brief All knobs at once, the three refinement_* limits into pcl::Registration's
+   * setMaximumIterations(), setMaxCorrespondenceDistance() and setTransformationEpsilon().
+   * \throws std::invalid_argument when parameters.validate() fails
+   */
+  void setParameters(const Parameters& parameters);
 
-  const Parameters& getParameters() const { return params_; }
+  /// The knobs, the three refinement_* limits read from pcl::Registration's.
+  Parameters getParameters() const;
 
-  // One setter/getter pair per field of Parameters. A setter throws std::invalid_argument
-  // when the value is outside the field's own range (StaticSceneRegistrationParameters::
-  // table()) and keeps the old value.
+  // One setter/getter pair per field of Parameters, except the three that are
+  // pcl::Registration's (see the class doc). A setter throws std::invalid_argument when the
+  // value is outside the field's own range (StaticSceneRegistrationParameters::table()) and
+  // keeps the old value. pcl::Registration's setters do not check; align() throws
+  // std::invalid_argument when getParameters().validate() fails.
   DYNVO_PARAMETER_ACCESSORS(InlierThreshold, th_inlier)
   DYNVO_PARAMETER_ACCESSORS(TrimFactor, trim_factor)
   DYNVO_PARAMETER_ACCESSORS(TrimRounds, trim_rounds)
   DYNVO_PARAMETER_ACCESSORS(MinCorrespondences, min_correspondences)
   DYNVO_PARAMETER_ACCESSORS(Refinement, refinement)
-  DYNVO_PARAMETER_ACCESSORS(RefinementMaxCorrespondenceDistance,
-                            refinement_max_correspondence_distance)
-  DYNVO_PARAMETER_ACCESSORS(RefinementMaxIterations, refinement_max_iterations)
-  DYNVO_PARAMETER_ACCESSORS(RefinementTransformationEpsilon,
-                            refinement_transformation_epsilon)
   DYNVO_PARAMETER_ACCESSORS(RefinementStride, refinement_stride)
 
 protected:
   using Base::converged_;
+  using Base::corr_dist_threshold_;
   using Base::fake_indices_;
   using Base::final_transformation_;
   using Base::indices_;
   using Base::input_;
+  using Base::max_iterations_;
   using Base::reg_name_;
   using Base::target_;
   using Base::transformation_;
+  using Base::transformation_epsilon_;
 
-  /// Runs the flow estimate and the optional refinement (called by pcl::Registration::align).
+  /// Checks the inputs, runs the flow estimate and the optional refinement (called by
+  /// pcl::Registration::align). \throws std::invalid_argument on invalid parameters
   void computeTransformation(PointCloud& output, const Matrix4& guess) override;
 
   /// Non-null organized source, target and flow; equal source and target sizes; a flow grid
-  /// matching the cloud (see the class doc); indices in range. Logs PCL_ERROR otherwise.
-  bool validateInputs() const;
+  /// matching the cloud (see the class doc), static cells on the same grid; indices in range.
+  /// Sets grid_; logs PCL_ERROR otherwise.
+  bool validateInputs();
+
+  /// Keeps the indices the base class just stored as the user's, then updateIndices().
+  void adoptIndices();
+
+  /// The indices pcl::Registration::align() copies: the centres of the static cells when
+  /// they are set, else the indices given last, range-checked against the source (rejected
+  /// ones are replaced by none and logged with PCL_ERROR).
+  void updateIndices();
 
   /// Collects S from the indices and the flow (fills source_points_, target_points_, weights_).
   void collectCorrespondences();
@@ -179,19 +234,24 @@ protected:
   bool estimateFromFlow();
 
   /// ICP/GICP from flow_transformation_; true and writes refined when PCL reports convergence.
-  bool refine(Matrix4& refined) const;
+  bool refine(const Parameters& parameters, Matrix4& refined) const;
 
 private:
-  /// Stores checked parameters.
+  /// Stores checked parameters from a per-field setter (the three refinement_* limits stay
+  /// pcl::Registration's).
   void assignParameters(const Parameters& parameters) { params_ = parameters; }
 
   /// Clears every result; the final transformation becomes the guess.
   void resetResults(const Matrix4& guess);
 
-  Parameters params_;                                   ///< validated knobs
-  FlowCloudConstPtr flow_;                              ///< grid scene flow k-1 -> k
-  Status status_ = Status::not_computed;                ///< outcome of the last align()
-  double fitness_ = std::numeric_limits<double>::max(); ///< mean kept E_i (m^2)
+  Parameters params_;                    ///< validated knobs
+  FlowCloudConstPtr flow_;               ///< grid scene flow k-1 -> k
+  Status status_ = Status::not_computed; ///< outcome of the last align()
+  double mean_squared_residual_ =
+      std::numeric_limits<double>::max(); ///< mean kept E_i (m^2)
+  pcl::IndicesPtr user_indices_;          ///< the indices given last (null: none)
+  int rejected_index_ = 0;                ///< first out-of-range index of user_indices_
+  bool indices_rejected_ = false;         ///< user_indices_ do not fit the source
   Matrix4 flow_transformation_ =
       Matrix4::Identity();       ///< trimmed flow estimate T_prev_curr
   std::size_t inlier_count_ = 0; ///< cells the flow estimate was fitted on
@@ -199,7 +259,9 @@ private:
   std::vector<Eigen::Vector3d> target_points_; ///< a_i of S (metres, previous frame)
   std::vector<double> weights_;                ///< flow weight of each cell of S
   std::vector<std::uint8_t> inliers_; ///< 1 for the cells of S kept by the trimming
-  std::vector<std::uint8_t> static_cells_; ///< per grid cell: selected by an index
+  FlowGrid static_cells_input_;       ///< setStaticCells(); empty when not set
+  FlowGrid grid_;                     ///< geometry of the flow on the source cloud
+  std::vector<std::uint8_t> static_cells_; ///< per grid cell: selected
 };
 
 } // namespace dynvo

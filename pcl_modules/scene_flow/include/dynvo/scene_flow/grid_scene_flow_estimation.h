@@ -27,7 +27,9 @@ namespace dynvo {
  * b_i (metres, current camera frame) goes to x, y, z, a_i (metres, previous camera frame) to
  * prev_x, prev_y, prev_z of a PointFlow. For a static point b_i = T_curr_prev * a_i.
  *
- * Output: organized (width / cell_size) x (height / cell_size) cloud; cell i = row * cols + col.
+ * Output: organized (width / cell_size) x (height / cell_size) cloud; cell i = row * cols + col,
+ * the geometry of FlowGrid, from which the consumers infer the cell size (a cell size for which
+ * width / (width / cell_size) != cell_size is an input error, see FlowGrid::isInferable()).
  * u, v always hold c_i. valid_2d cells hold p_i in prev_u, prev_v (NaN otherwise); x, y, z hold b_i
  * whenever depth exists at c_i; valid_3d cells also hold a_i and a weight in (0, 1]. Every other
  * field is NaN and the weight 0. setIndices() is not used: every cell is computed.
@@ -129,7 +131,8 @@ protected:
   /// Non-null, organized inputs of equal size; logs PCL_ERROR and returns false otherwise.
   bool initCompute();
 
-  /// The image holds at least one grid cell; logs PCL_ERROR and returns false otherwise.
+  /// The image holds at least one grid cell and its grid gives the cell size back
+  /// (FlowGrid::isInferable()); logs PCL_ERROR and returns false otherwise.
   bool validateInputs() const;
 
   /// Converts a cloud to grey levels and depths and prepares it in an engine slot.

@@ -78,7 +78,7 @@ template <typename PointT>
 void
 RigidMotionSegmentation<PointT>::clearOutputs()
 {
-  cell_labels_.clear();
+  cell_grid_ = FlowGrid();
   segment_labels_.clear();
   motions_.clear();
   spatial_ = SpatialSegmentationResult();
@@ -104,15 +104,13 @@ RigidMotionSegmentation<PointT>::initCompute()
 
 template <typename PointT>
 bool
-RigidMotionSegmentation<PointT>::validateInputs() const
+RigidMotionSegmentation<PointT>::validateInputs()
 {
-  const auto cell = static_cast<std::uint32_t>(params_.cell_size);
-  if (flow_->width != input_->width / cell || flow_->height != input_->height / cell ||
-      flow_->empty()) {
-    PCL_ERROR("[dynvo::%s::segment] a %ux%u flow grid does not fit a %ux%u cloud with "
-              "%u px cells.\n",
+  if (!FlowGrid::fromFlow(*flow_, input_->width, input_->height, cell_grid_)) {
+    PCL_ERROR("[dynvo::%s::segment] a %ux%u flow grid does not tile a %ux%u cloud "
+              "(cell size = width / flow width).\n",
               getClassName().c_str(), flow_->width, flow_->height, input_->width,
-              input_->height, cell);
+              input_->height);
     return false;
   }
   return true;
@@ -128,7 +126,7 @@ RigidMotionSegmentation<PointT>::computeImplIndices(
   slot.fill(-1);
   for (std::size_t s = 0; s < segment_labels_.size(); ++s)
     slot[segment_labels_[s]] = static_cast<int>(s);
-  const int cell = params_.cell_size;
+  const int cell = static_cast<int>(cell_grid_.cell_size);
   const int width = static_cast<int>(input_->width);
   const int cols = static_cast<int>(flow_->width);
   const int rows = static_cast<int>(flow_->height);
@@ -146,7 +144,7 @@ RigidMotionSegmentation<PointT>::computeImplIndices(
     std::vector<std::size_t> size(out.size(), 0);
     for (int r = first_row; r < end_row; ++r)
       for (int c = 0; c < cols; ++c) {
-        const int s = slot[cell_labels_[static_cast<std::size_t>(r) * cols + c]];
+        const int s = slot[cell_grid_.labels[static_cast<std::size_t>(r) * cols + c]];
         if (s >= 0)
           size[s] += static_cast<std::size_t>(cell) * cell;
       }
@@ -156,7 +154,7 @@ RigidMotionSegmentation<PointT>::computeImplIndices(
     for (int r = first_row; r < end_row; ++r)
       for (int v = r * cell; v < (r + 1) * cell; ++v)
         for (int c = 0; c < cols; ++c) {
-          const int s = slot[cell_labels_[static_cast<std::size_t>(r) * cols + c]];
+          const int s = slot[cell_grid_.labels[static_cast<std::size_t>(r) * cols + c]];
           if (s < 0)
             continue;
           int* write = out[s].data();
@@ -200,7 +198,7 @@ RigidMotionSegmentation<PointT>::segment(std::vector<pcl::PointIndices>& segment
   } guard{*this};
   if (!validateInputs())
     return;
-  grid_.assign(*flow_, params_.cell_size);
+  grid_.assign(*flow_, cell_grid_);
   computeInformation();
   segmenter_.segment(grid_, params_, spatial_);
   PCL_DEBUG("[dynvo::%s::segment] %d segments from %zu hypotheses (%d trials).\n",
@@ -209,14 +207,14 @@ RigidMotionSegmentation<PointT>::segment(std::vector<pcl::PointIndices>& segment
   if (params_.tracking) {
     tracker_.update(grid_, spatial_, predicted_motion_.cast<double>(), intrinsics_,
                     params_);
-    cell_labels_ = tracker_.labels();
+    cell_grid_.labels = tracker_.labels();
     segment_labels_ = tracker_.ids();
     for (const Eigen::Matrix4d& H : tracker_.motions())
       motions_.push_back(H.cast<float>());
   }
   else {
     // Two-frame result: segments by size, the largest taken as the background.
-    cell_labels_ = spatial_.labels;
+    cell_grid_.labels = spatial_.labels;
     segment_labels_.push_back(LABEL_STATIC);
     motions_.push_back(spatial_.motions.empty() ? predicted_motion_
                                                 : spatial_.motions[0].cast<float>());

@@ -16,8 +16,92 @@ namespace dynvo {
 template <typename PointT> StaticSceneRegistration<PointT>::StaticSceneRegistration()
 {
   reg_name_ = "StaticSceneRegistration";
-  // The flow gives the correspondences: never build the base class's kd-tree on the target.
-  Base::setSearchMethodTarget(Base::getSearchMethodTarget(), true);
+  // The flow gives the correspondences: the target's kd-tree is only built when the base
+  // class's getFitnessScore(max_range) asks for it.
+  Base::setSearchMethodTarget(pcl::make_shared<detail::LazyKdTree<PointT>>());
+  setParameters(Parameters());
+}
+
+template <typename PointT>
+void
+StaticSceneRegistration<PointT>::setParameters(const Parameters& parameters)
+{
+  parameters.validate();
+  assignParameters(parameters);
+  max_iterations_ = parameters.refinement_max_iterations;
+  corr_dist_threshold_ = parameters.refinement_max_correspondence_distance;
+  transformation_epsilon_ = parameters.refinement_transformation_epsilon;
+}
+
+template <typename PointT>
+typename StaticSceneRegistration<PointT>::Parameters
+StaticSceneRegistration<PointT>::getParameters() const
+{
+  Parameters parameters = params_;
+  parameters.refinement_max_iterations = max_iterations_;
+  parameters.refinement_max_correspondence_distance = corr_dist_threshold_;
+  parameters.refinement_transformation_epsilon = transformation_epsilon_;
+  return parameters;
+}
+
+template <typename PointT>
+void
+StaticSceneRegistration<PointT>::adoptIndices()
+{
+  user_indices_ = indices_;
+  updateIndices();
+}
+
+template <typename PointT>
+void
+StaticSceneRegistration<PointT>::setStaticCells(const FlowGrid& cells)
+{
+  static_cells_input_ = cells;
+  updateIndices();
+}
+
+template <typename PointT>
+void
+StaticSceneRegistration<PointT>::setInputSource(const PointCloudConstPtr& cloud)
+{
+  Base::setInputSource(cloud);
+  updateIndices();
+}
+
+template <typename PointT>
+void
+StaticSceneRegistration<PointT>::updateIndices()
+{
+  indices_rejected_ = false;
+  if (static_cells_input_.size() > 0) {
+    // The centres of the static cells: a small output, and in range whenever the cells are
+    // on the source's grid (otherwise validateInputs() rejects them).
+    auto centres = pcl::make_shared<pcl::Indices>();
+    if (input_ && static_cells_input_.image_width == input_->width &&
+        static_cells_input_.image_height == input_->height)
+      for (std::size_t i = 0; i < static_cells_input_.size(); ++i)
+        if (static_cells_input_.labels[i] == LABEL_STATIC)
+          centres->push_back(
+              static_cast<pcl::index_t>(static_cells_input_.centreIndex(i)));
+    indices_ = centres;
+    fake_indices_ = false;
+    return;
+  }
+  indices_ = user_indices_;
+  fake_indices_ = false;
+  if (!user_indices_ || !input_)
+    return;
+  for (const auto index : *user_indices_) {
+    if (index < 0 || static_cast<std::size_t>(index) >= input_->size()) {
+      indices_rejected_ = true;
+      rejected_index_ = static_cast<int>(index);
+      PCL_ERROR(
+          "[dynvo::%s::setIndices] index %d is outside the %zu-point source cloud.\n",
+          reg_name_.c_str(), rejected_index_, input_->size());
+      indices_ = pcl::make_shared<pcl::Indices>();
+      return;
+    }
+  }
 }
 
 template <typename PointT>
@@ -29,7 +113,7 @@ StaticSceneRegistration<PointT>::resetResults(const Matrix4& guess)
   transformation_ = guess;
   flow_transformation_ = guess;
   status_ = Status::invalid_input;
-  fitness_ = std::numeric_limits<double>::max();
+  mean_squared_residual_ = std::numeric_limits<double>::max();
   inlier_count_ = 0;
   source_points_.clear();
   target_points_.clear();
@@ -38,20 +122,8 @@ StaticSceneRegistration<PointT>::resetResults(const Matrix4& guess)
 }
 
 template <typename PointT>
-void
-StaticSceneRegistration<PointT>::align(PointCloud& output, const Matrix4& guess)
-{
-  output.clear();
-  resetResults(guess);
-  // Checked before the base class copies the indexed points, which it does unchecked.
-  if (!validateInputs())
-    return;
-  Base::align(output, guess);
-}
-
-template <typename PointT>
 bool
-StaticSceneRegistration<PointT>::validateInputs() const
+StaticSceneRegistration<PointT>::validateInputs()
 {
   const char* name = reg_name_.c_str();
   if (!input_ || !target_ || !flow_) {
@@ -73,22 +145,26 @@ StaticSceneRegistration<PointT>::validateInputs() const
               name, input_->width, input_->height, target_->width, target_->height);
     return false;
   }
-  const std::uint32_t cell = flow_->width > 0 ? input_->width / flow_->width : 0;
-  if (cell == 0 || input_->height / cell != flow_->height) {
+  if (!FlowGrid::fromFlow(*flow_, input_->width, input_->height, grid_)) {
     PCL_ERROR("[dynvo::%s::align] a %ux%u flow grid does not tile a %ux%u cloud "
               "(cell size = width / flow width).\n",
               name, flow_->width, flow_->height, input_->width, input_->height);
     return false;
   }
-  if (indices_ && !fake_indices_) {
-    for (const auto index : *indices_) {
-      if (index < 0 || static_cast<std::size_t>(index) >= input_->size()) {
-        PCL_ERROR(
-            "[dynvo::%s::align] index %d is outside the %zu-point source cloud.\n",
-            name, static_cast<int>(index), input_->size());
-        return false;
-      }
-    }
+  if (static_cells_input_.size() > 0 &&
+      (!static_cells_input_.sameGeometry(grid_) ||
+       static_cells_input_.labels.size() != grid_.size())) {
+    PCL_ERROR(
+        "[dynvo::%s::align] the static cells (%ux%u cells of %u px) are not on the "
+        "flow's grid (%ux%u cells of %u px).\n",
+        name, static_cells_input_.cols, static_cells_input_.rows,
+        static_cells_input_.cell_size, grid_.cols, grid_.rows, grid_.cell_size);
+    return false;
+  }
+  if (indices_rejected_) {
+    PCL_ERROR("[dynvo::%s::align] index %d is outside the %zu-point source cloud.\n",
+              name, rejected_index_, input_->size());
+    return false;
   }
   return true;
 }
@@ -97,16 +173,17 @@ template <typename PointT>
 void
 StaticSceneRegistration<PointT>::collectCorrespondences()
 {
-  const std::size_t width = input_->width;
-  const std::size_t grid_width = flow_->width;
-  const std::size_t grid_height = flow_->height;
-  const std::size_t cell = width / grid_width;
-  static_cells_.assign(flow_->size(), 0);
-  for (const auto index : *indices_) {
-    const std::size_t col = static_cast<std::size_t>(index) % width / cell;
-    const std::size_t row = static_cast<std::size_t>(index) / width / cell;
-    if (col < grid_width && row < grid_height)
-      static_cells_[row * grid_width + col] = 1;
+  static_cells_.assign(grid_.size(), 0);
+  if (static_cells_input_.size() > 0) {
+    for (std::size_t i = 0; i < grid_.size(); ++i)
+      static_cells_[i] = static_cells_input_.labels[i] == LABEL_STATIC;
+  }
+  else {
+    for (const auto index : *indices_) {
+      const std::size_t i = grid_.cellOfPixel(static_cast<std::size_t>(index));
+      if (i < grid_.size())
+        static_cells_[i] = 1;
+    }
   }
   for (std::size_t i = 0; i < flow_->size(); ++i) {
     const PointFlow& f = (*flow_)[i];
@@ -169,18 +246,28 @@ StaticSceneRegistration<PointT>::estimateFromFlow()
 
 template <typename PointT>
 bool
-StaticSceneRegistration<PointT>::refine(Matrix4& refined) const
+StaticSceneRegistration<PointT>::refine(const Parameters& parameters,
+                                        Matrix4& refined) const
 {
-  const std::size_t stride = static_cast<std::size_t>(params_.refinement_stride);
+  const std::size_t stride = static_cast<std::size_t>(parameters.refinement_stride);
   const std::size_t width = input_->width;
   const auto on_lattice = [stride, width](std::size_t index) {
     return index % width % stride == 0 && index / width % stride == 0;
   };
   pcl::PointCloud<pcl::PointXYZ>::Ptr source(new pcl::PointCloud<pcl::PointXYZ>);
-  for (const auto index : *indices_) {
+  const auto add_source = [&](std::size_t index) {
     const PointT& p = (*input_)[index];
-    if (on_lattice(static_cast<std::size_t>(index)) && pcl::isXYZFinite(p))
+    if (on_lattice(index) && pcl::isXYZFinite(p))
       source->push_back(pcl::PointXYZ(p.x, p.y, p.z));
+  };
+  if (static_cells_input_.size() > 0) {
+    for (std::size_t i = 0; i < grid_.size(); ++i)
+      if (static_cells_[i])
+        grid_.forEachPixel(i, add_source);
+  }
+  else {
+    for (const auto index : *indices_)
+      add_source(static_cast<std::size_t>(index));
   }
   pcl::PointCloud<pcl::PointXYZ>::Ptr target(new pcl::PointCloud<pcl::PointXYZ>);
   for (std::size_t index = 0; index < target_->size(); ++index) {
@@ -195,8 +282,8 @@ StaticSceneRegistration<PointT>::refine(Matrix4& refined) const
               reg_name_.c_str(), source->size(), target->size());
     return false;
   }
-  return detail::refineRigidTransformation(source, target, params_.refinement, params_,
-                                           flow_transformation_, refined);
+  return detail::refineRigidTransformation(source, target, parameters.refinement,
+                                           parameters, flow_transformation_, refined);
 }
 
 template <typename PointT>
@@ -204,8 +291,10 @@ void
 StaticSceneRegistration<PointT>::computeTransformation(PointCloud& output,
                                                        const Matrix4& guess)
 {
+  const Parameters parameters = getParameters();
+  // The per-field setters and pcl::Registration's do not check what ties the fields.
+  parameters.validate();
   resetResults(guess);
-  // Repeated here for calls through a pcl::Registration reference, which bypass align().
   if (!validateInputs()) {
     output.clear();
     return;
@@ -220,7 +309,7 @@ StaticSceneRegistration<PointT>::computeTransformation(PointCloud& output,
   final_transformation_ = flow_transformation_;
   if (params_.refinement != Refinement::none) {
     Matrix4 refined;
-    if (refine(refined))
+    if (refine(parameters, refined))
       final_transformation_ = refined;
     else
       status_ = Status::refinement_not_converged;
@@ -232,7 +321,7 @@ StaticSceneRegistration<PointT>::computeTransformation(PointCloud& output,
     if (inliers_[i])
       residual_sum +=
           squaredTransferError(T_final, source_points_[i], target_points_[i]);
-  fitness_ = residual_sum / static_cast<double>(inlier_count_);
+  mean_squared_residual_ = residual_sum / static_cast<double>(inlier_count_);
   pcl::transformPointCloud(output, output, final_transformation_);
 }
 

@@ -2,6 +2,7 @@
 // Template bodies of GridSceneFlowEstimation (compiled in src/ for XYZRGB and XYZRGBA).
 #pragma once
 
+#include <dynvo/common/flow_grid.h>
 #include <dynvo/scene_flow/grid_scene_flow_estimation.h>
 
 #include <pcl/console/print.h>
@@ -108,6 +109,15 @@ GridSceneFlowEstimation<PointT>::validateInputs() const
   if (input_->width < cell || input_->height < cell) {
     PCL_ERROR("[dynvo::%s::compute] a %ux%u cloud holds no %u px grid cell.\n",
               getClassName().c_str(), input_->width, input_->height, cell);
+    return false;
+  }
+  // The consumers infer the cell size as width / grid columns (FlowGrid::fromFlow()).
+  if (!FlowGrid(input_->width, input_->height, cell).isInferable()) {
+    PCL_ERROR(
+        "[dynvo::%s::compute] %u px cells on a %u px wide cloud leave more columns "
+        "over than there are cells: the cell size could not be inferred from the "
+        "grid.\n",
+        getClassName().c_str(), cell, input_->width);
     return false;
   }
   return true;
