@@ -19,7 +19,8 @@ namespace dynvo {
  * The transfer error e = R a + t - b of a static point seen as a in one frame and b in the
  * next has covariance about Sigma(a) + Sigma(b) (R is close to identity frame to frame), so
  * e^T (Sigma(a) + Sigma(b))^-1 e is chi-square with 3 degrees of freedom for a static point.
- * The defaults are measured on real Kinect v1 data (docs/algorithm.md §12.1).
+ * Defaults: the published Kinect v1 axial model and 0.6 px, the median lateral error measured
+ * on TUM fr1/xyz (pcl_modules/motion_segmentation/NOTES.md); docs/algorithm.md §2.
  */
 struct DYNVO_EXPORTS SensorNoiseModel {
   float axial_base = 1.2e-3f;      ///< sigma_0 (metres, > 0): axial sigma at axial_offset

@@ -263,11 +263,20 @@ SegmentTracker::guardBackground(const GridFlowData& grid,
   if (g == 0)
     return;
   // r_pred(c): RMS residual of segment c under the constant-velocity prediction (metres).
+  // [D] Sensor model: RMS distance between where the segment's motion and the prediction
+  // move its points, so that depth noise (3 cm at 4 m) does not count as a departure.
+  const bool sensor = !grid.information.empty();
   std::vector<double> sum(g + 1, 0.0);
-  for (std::size_t i = 0; i < grid.size(); ++i)
-    if (spatial.labels[i] != 0)
-      sum[spatial.labels[i]] += squaredTransferError(T_pred, grid.a[i].cast<double>(),
-                                                     grid.b[i].cast<double>());
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    const int c = spatial.labels[i];
+    if (c == 0)
+      continue;
+    const Eigen::Vector3d a = grid.a[i].cast<double>();
+    const Eigen::Vector3d b =
+        sensor ? Eigen::Vector3d((spatial.motions[c - 1] * a.homogeneous()).head<3>())
+               : grid.b[i].cast<double>();
+    sum[c] += squaredTransferError(T_pred, a, b);
+  }
   int c1 = 0, best = 0;
   std::vector<double> r(g + 1, 0.0);
   for (int c = 1; c <= g; ++c) {
@@ -318,7 +327,7 @@ SegmentTracker::mergeNoiseSplits(const GridFlowData& grid,
       errors[c].push_back(grid.error(i, R, t));
   }
   for (int c = 1; c <= g; ++c)
-    if (!errors[c].empty() && median(errors[c]) <= 0.25f * params.inlier_chi2)
+    if (!errors[c].empty() && median(errors[c]) <= 0.5f * params.inlier_chi2)
       ids[c] = LABEL_STATIC;
 }
 

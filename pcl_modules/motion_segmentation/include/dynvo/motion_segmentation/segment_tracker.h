@@ -109,7 +109,7 @@ private:
                        std::vector<int>& ids) const;
 
   /** \brief [D] Sensor model: a segment whose typical cell the background's motion explains
-   * (median E_i under the label-1 segment's motion <= th_chi2 / 4, about 2 sigma) is the
+   * (median E_i under the label-1 segment's motion <= th_chi2 / 2, 2.8 sigma) is the
    * background split by noise (near and far parts, colour and depth not taken at one
    * instant); it takes label 1. Paper model: no change.
    */

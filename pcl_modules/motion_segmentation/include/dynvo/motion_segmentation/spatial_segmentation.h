@@ -62,7 +62,7 @@ DYNVO_EXPORTS double motionFieldDistance(const MotionHypothesis& x,
                                          const std::vector<Eigen::Vector3f>& a,
                                          const std::vector<Eigen::Matrix3f>& information);
 
-/// The three thresholds of the search in the unit of E_i (docs/algorithm.md §3.0).
+/// The three thresholds of the search in the unit of E_i (docs/algorithm.md §2).
 struct DYNVO_EXPORTS ResidualThresholds {
   float inlier = 0.0f;  ///< th: E_i <= th is an inlier
   float lambda = 0.0f;  ///< entropy shape, per unit of E_i
