@@ -213,7 +213,8 @@ TEST_F(OdometryApp, CloudsAreLabelledPcdsOfEveryNthFrame)
   EXPECT_EQ(finite_unlabelled, 0u);
 }
 
-/// Runs of consecutive frames per id in an objects file: id -> (first, last frame index).
+/// Runs of consecutive frames per id in an objects file: id -> (first, last frame
+/// index).
 std::multimap<int, std::pair<std::size_t, std::size_t>>
 objectRuns(const std::string& objects_file, const dynvo::Trajectory& trajectory)
 {
@@ -276,9 +277,9 @@ TEST_F(OdometryApp, ObjectTrajectoriesFollowTheMotionsOfTheObjectsFile)
     EXPECT_GT(z, 0.5);
     EXPECT_LT(z, 4.5);
   }
-  // Each later pose is T_world_curr * T_curr_prev * inv(T_world_prev) * the previous one,
-  // with the motions of the -objects file (translations to 1 um, quaternions to 1e-9:
-  // over 4 m of lever arm below 1e-5 m per step).
+  // Each later pose is T_world_curr * T_curr_prev * inv(T_world_prev) * the previous
+  // one, with the motions of the -objects file (translations to 1 um, quaternions to
+  // 1e-9: over 4 m of lever arm below 1e-5 m per step).
   std::map<std::pair<double, int>, Eigen::Isometry3d> motions;
   std::ifstream in(out_.file("o.txt"));
   std::string line;

@@ -470,10 +470,10 @@ TEST(TrajectoryPlot, ObjectPathsAreDrawnInTheirLabelColours)
                                          {{2, crossing}, {3, far}}));
   const cv::Mat image = cv::imread(dir.file("plot.png"), cv::IMREAD_COLOR);
   ASSERT_EQ(image.cols, int(options.width));
-  // Without ground truth the path chart takes the whole width, its legend (with a sample
-  // of each colour) in the top-right corner. Each object's path is a line in its label's
-  // palette colour: the crossing one vertical (along z), the far one horizontal (along x)
-  // and above the crossing one (larger z).
+  // Without ground truth the path chart takes the whole width, its legend (with a
+  // sample of each colour) in the top-right corner. Each object's path is a line in its
+  // label's palette colour: the crossing one vertical (along z), the far one horizontal
+  // (along x) and above the crossing one (larger z).
   const int tolerance = 40; // anti-aliased line edges, as above
   const int left_of_legend = image.cols * 4 / 5;
   int count2 = 0, count3 = 0;

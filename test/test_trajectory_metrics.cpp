@@ -160,9 +160,9 @@ TEST(TrajectoryMetricsRealData, Fr1GroundTruthAgainstDriftingCopy)
 
 TEST(ObjectRpe, FixedOffsetsOfWorldAndObjectFrameScoreZero)
 {
-  // The estimate is the true object seen from another world (A) with another object frame
-  // (B: a point on its surface, other axes). Plain RPE of the poses is not invariant to B
-  // once the object rotates; the point path is.
+  // The estimate is the true object seen from another world (A) with another object
+  // frame (B: a point on its surface, other axes). Plain RPE of the poses is not
+  // invariant to B once the object rotates; the point path is.
   const Eigen::Isometry3d A = Eigen::Translation3d(0.5, -0.2, 1.0) *
                               Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitY());
   const Eigen::Isometry3d B = Eigen::Translation3d(0.1, -0.15, 0.2) *

@@ -38,9 +38,11 @@ poseOf(const std::vector<double>& values, std::size_t first, const std::string& 
   return pose;
 }
 
-/** \brief Calls on_line(values, where) for every line that is not blank or a '#' comment,
- * after checking that it holds exactly `columns` finite numbers (commas count as blanks).
- * \throws pcl::IOException "<file>:<line>: <problem>", or when the file cannot be opened
+/** \brief Calls on_line(values, where) for every line that is not blank or a '#'
+ * comment, after checking that it holds exactly `columns` finite numbers (commas count
+ * as blanks).
+ * \throws pcl::IOException "<file>:<line>: <problem>", or when the file cannot be
+ * opened
  */
 void
 readNumberLines(

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Object-to-world trajectories of the tracked objects of a run (dynvo_odometry -objects_dir).
+// Object-to-world trajectories of the tracked objects of a run (-objects_dir).
 #pragma once
 
 #include <dynvo/app/odometry_pipeline.h>
@@ -19,17 +19,17 @@
 
 namespace dynvo::app {
 
-/// A frame counts as moving for an object when its frame origin moves faster than this in
-/// the world (m/s): the accuracy asked of object trajectories (issue 15), below which a
-/// speed cannot be told from rest.
+/// A frame counts as moving for an object when its frame origin moves faster than this
+/// in the world (m/s): the accuracy asked of object trajectories (issue 15), below
+/// which a speed cannot be told from rest.
 constexpr double OBJECT_MOVING_SPEED = 0.05;
 
 /// The trajectory of one tracked object and its summary figures.
 struct DYNVO_EXPORTS ObjectTrack {
   int id = 0;  ///< segment label (2..)
   int run = 1; ///< 1 for the id's first run of consecutive frames, 2 for its next, ...
-  /// T_world_object at each frame of the run (TUM poses, metres). The object frame has its
-  /// origin at the segment's centroid and the camera's axes at the run's first frame.
+  /// T_world_object at each frame of the run (TUM poses, metres). The object frame has
+  /// its origin at the segment's centroid, the camera's axes, at the run's first frame.
   Trajectory poses;
   std::size_t frames_moving =
       0;                    ///< frames after the first faster than OBJECT_MOVING_SPEED
@@ -43,12 +43,13 @@ struct DYNVO_EXPORTS ObjectTrack {
  * frame-to-frame motions.
  *
  * An object is a run of consecutive frames with a segment of one id: the tracker hands
- * the id of a segment that disappeared to a later, unrelated segment, so an id that comes
- * back after a frame without it starts a new run (ObjectTrack::run). At a run's first
- * frame, T_world_object = T_world_curr * [I | c], c the centroid of the segment's finite
- * points (camera frame); at each later frame, T_world_object = T_world_curr *
- * T_curr_prev(s) * inv(T_world_prev) * T_world_object(prev), where T_curr_prev(s) is the
- * segment's motion (FrameResult::motions) and T_world_prev the previous camera pose.
+ * the id of a segment that disappeared to a later, unrelated segment, so an id that
+ * comes back after a frame without it starts a new run (ObjectTrack::run). At a run's
+ * first frame, T_world_object = T_world_curr * [I | c], c the centroid of the segment's
+ * finite points (camera frame); at each later frame, T_world_object = T_world_curr *
+ * T_curr_prev(s) * inv(T_world_prev) * T_world_object(prev), where T_curr_prev(s) is
+ * the segment's motion (FrameResult::motions) and T_world_prev the previous camera
+ * pose.
  */
 class DYNVO_EXPORTS ObjectTrajectories {
 public:
@@ -76,11 +77,11 @@ private:
 DYNVO_EXPORTS std::string objectTrajectoryName(int id, int run);
 
 /** \brief Writes an objects folder: object_<id>_<run>.txt per track (TUM,
- * object-to-world), camera.txt (the run's camera trajectory: the world the objects are
- * in) and objects_summary.txt, whose '#' header documents the columns "id run first_stamp
- * last_stamp frames_seen frames_moving mean_speed path_length". Each file is replaced
- * whole (PartialFile); the summary lists the tracks of this run, so it is the folder's
- * index.
+ * object-to-world), camera.txt (the run's camera trajectory: the world the objects
+ * are in) and objects_summary.txt, whose '#' header documents the columns "id run
+ * first_stamp last_stamp frames_seen frames_moving mean_speed path_length". Each file
+ * is replaced whole (PartialFile); the summary lists the tracks of this run, so it is
+ * the folder's index.
  * \throws pcl::IOException naming the file that cannot be written
  */
 DYNVO_EXPORTS void writeObjectsFolder(const std::string& folder,
@@ -111,7 +112,7 @@ struct ObjectScore {
   int truth_id = 0; ///< matched true object (0 = none within OBJECT_MATCH_DISTANCE)
   std::size_t frames = 0; ///< frames of its trajectory
   double seconds = 0.0;   ///< last stamp - first stamp (s)
-  double distance = 0.0;  ///< mean distance to the nearest true object's origin (m)
+  double distance = 0.0;  ///< mean distance to the nearest true origin (m; 0: none)
   RpeResult rpe;          ///< computeObjectRpe() (pairs 0: not scored, 1 s or shorter)
 };
 
@@ -119,10 +120,10 @@ struct ObjectScore {
  * objects.txt and groundtruth.txt.
  *
  * Each object's estimate is moved into the truth's world by the camera at its first
- * stamp t_0: T_truth_estimate = groundtruth(t_0) * inv(camera.txt(t_0)), so camera drift
- * before the object appeared does not count. It is matched to the true object whose
- * origin is nearest to the estimated origin on average over the estimate's frames (within
- * OBJECT_MATCH_DISTANCE), and scored with computeObjectRpe() (1 s pairs).
+ * stamp t_0: T_truth_estimate = groundtruth(t_0) * inv(camera.txt(t_0)), so camera
+ * drift before the object appeared does not count. It is matched to the true object
+ * whose origin is nearest to the estimated origin on average over the estimate's frames
+ * (within OBJECT_MATCH_DISTANCE), and scored with computeObjectRpe() (1 s pairs).
  * \throws pcl::IOException naming a file that is missing or malformed, or a stamp
  *         without ground truth
  */
@@ -130,10 +131,10 @@ DYNVO_EXPORTS std::vector<ObjectScore> evaluateObjects(const std::string& object
                                                        const std::string& sequence_dir);
 
 /** \brief The result lines of dynvo_evaluate -objects_dir, one per object: "object=<id>
- * truth=<id|none> frames=<n> seconds=<s> distance=<m> rpe_trans_rmse=<m/s|nan> pairs=<n>",
- * then "objects=<n> scored=<n> max_rpe_trans_rmse=<m/s|nan>" (scored: pairs > 0); with
- * json one JSON object {"objects": [...], "scored": n, "max_rpe_trans_rmse": x}. No
- * trailing newline.
+ * truth=<id|none> frames=<n> seconds=<s> distance=<m> rpe_trans_rmse=<m/s|nan>
+ * pairs=<n>", then "objects=<n> scored=<n> max_rpe_trans_rmse=<m/s|nan>" (scored:
+ * pairs > 0); with json one JSON object {"objects": [...], "scored": n,
+ * "max_rpe_trans_rmse": x}. No trailing newline.
  */
 DYNVO_EXPORTS std::string formatObjectScores(const std::vector<ObjectScore>& scores,
                                              bool json = false);

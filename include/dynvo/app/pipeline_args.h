@@ -64,17 +64,17 @@ DYNVO_EXPORTS bool writeConfigIfRequested(const Arguments& args,
 /// \throws UsageError when it is not a whole number >= 0
 DYNVO_EXPORTS std::size_t maxFramesFromArguments(const Arguments& args);
 
-/** \brief prepareOutputs() for a run over a recording: the app's outputs plus the shared
- * -objects, -objects_dir and -clouds_dir; the inputs are the source's files and the
- * -config file.
+/** \brief prepareOutputs() for a run over a recording: the app's outputs plus the
+ * shared -objects, -objects_dir and -clouds_dir; the inputs are the source's files and
+ * the -config file.
  * \throws UsageError naming the flag, the path and the problem
  */
 DYNVO_EXPORTS void prepareRunOutputs(const Arguments& args,
                                      const FrameSource& source,
                                      std::vector<OutputPath> outputs);
 
-/** \brief The outputs of a run: the app's trajectory and label folder ("" = none) plus the
- * shared -objects, -objects_dir, -clouds_dir and -clouds_every N (default 1).
+/** \brief The outputs of a run: the app's trajectory and label folder ("" = none) plus
+ * the shared -objects, -objects_dir, -clouds_dir and -clouds_every N (default 1).
  * \throws UsageError when -clouds_every is not a whole number >= 1 or is given without
  *         -clouds_dir
  */

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// What an odometry run writes (trajectory, label images, labelled clouds, object motions and
-// trajectories) and prints.
+// What an odometry run writes (trajectory, label images, labelled clouds, object
+// motions and trajectories) and prints.
 #pragma once
 
 #include <dynvo/app/object_trajectories.h>
@@ -27,16 +27,17 @@ struct RunOutputPaths {
   std::string objects_dir; ///< object trajectories and summary (writeObjectsFolder())
 };
 
-/** \brief The files of a run. Label images and clouds are written as frames arrive (each
- * replaced whole); the trajectory, the objects file and the objects folder are written by
- * finish() (the objects file beside its destination, "<file>.partial", until then), so an
- * interrupted run leaves earlier files untouched. finish() writes nothing when no frame
- * was added, so a run that fails on its first frame replaces nothing.
+/** \brief The files of a run. Label images and clouds are written as frames arrive
+ * (each replaced whole); the trajectory, the objects file and the objects folder are
+ * written by finish() (the objects file beside its destination, "<file>.partial", until
+ * then), so an interrupted run leaves earlier files untouched. finish() writes nothing
+ * when no frame was added, so a run that fails on its first frame replaces nothing.
  */
 class DYNVO_EXPORTS RunOutputs {
 public:
   /** \param[in] paths what to write; folders are created if needed
    * \param[in] initial_groundtruth when set, poses start at its pose nearest the first frame
+   * \throws std::invalid_argument when paths.clouds_every is 0
    * \throws pcl::IOException when a folder or file cannot be created
    */
   explicit RunOutputs(const RunOutputPaths& paths,
@@ -45,7 +46,8 @@ public:
   /// Records one frame. \throws pcl::IOException when a file cannot be written
   void add(const Frame& frame, const FrameResult& result);
 
-  /// Writes the trajectory and the objects folder and moves the objects file into place, when a frame was added.
+  /// Writes the trajectory and the objects folder and moves the objects file into
+  /// place, when a frame was added.
   /// \throws pcl::IOException when a file cannot be written
   void finish();
 

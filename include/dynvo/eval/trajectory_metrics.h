@@ -48,14 +48,14 @@ DYNVO_EXPORTS RpeResult computeRpe(const Trajectory& groundtruth,
 /** \brief Translational RPE of a tracked object's trajectory against the true object's.
  *
  * An estimated object frame and the true one differ by a fixed unknown offset, and the
- * plain RPE of object poses is not invariant to it, so what is scored is the world path of
- * one point of the object: the origin of the estimated object frame. Its estimated
+ * plain RPE of object poses is not invariant to it, so what is scored is the world path
+ * of one point of the object: the origin of the estimated object frame. Its estimated
  * positions are p_k = T_truth_estimate * estimate[k] origin (in the truth's world); its
- * true positions are q = truth(t) * b, with b = inv(truth(t_0)) * p_0 its coordinates in
- * the true object frame at the estimate's first stamp t_0 (truth interpolated,
+ * true positions are q = truth(t) * b, with b = inv(truth(t_0)) * p_0 its coordinates
+ * in the true object frame at the estimate's first stamp t_0 (truth interpolated,
  * interpolatePose()). computeRpe() of the two point paths then gives, per pair,
- * |(p_j - p_i) - (q_j - q_i)| (metres per delta); the rotation fields are 0 (the object's
- * rotation enters through q only).
+ * |(p_j - p_i) - (q_j - q_i)| (metres per delta); the rotation fields are 0 (the
+ * object's rotation enters through q only).
  * \param[in] truth true object-to-world poses
  * \param[in] estimate estimated object-to-world poses (the estimate's world)
  * \param[in] T_truth_estimate maps the estimate's world into the truth's

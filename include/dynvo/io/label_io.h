@@ -39,9 +39,9 @@ DYNVO_EXPORTS void writeLabelImage(const std::string& path, const LabelImage& la
 DYNVO_EXPORTS LabelImage readLabelImage(const std::string& path);
 
 /** \brief Writes a frame and its labels as an organized pcl::PointXYZRGBL PCD
- * (binary_compressed), which pcl_viewer colours by label. Point i is cloud[i] (NaN where
- * there is no depth) with label labels[i] (0 no label, 1 static, 2.. objects). The file
- * is written beside its destination and renamed into place (PartialFile).
+ * (binary_compressed), which pcl_viewer colours by label. Point i is cloud[i] (NaN
+ * where there is no depth) with label labels[i] (0 no label, 1 static, 2.. objects).
+ * The file is written beside its destination and renamed into place (PartialFile).
  * \param[in] path destination ("<stamp>.pcd" reads back through PcdSequenceSource)
  * \param[in] cloud the organized frame (metres)
  * \param[in] labels one label per point of cloud, row-major

@@ -23,9 +23,9 @@ namespace dynvo {
  */
 DYNVO_EXPORTS Trajectory readTrajectory(const std::string& path);
 
-/** \brief Read the objects.txt of a dynvo_synthesize sequence: lines "timestamp id tx ty
- * tz qx qy qz qw moving" (object-to-world, metres; moving 0 or 1), with the checks of
- * readTrajectory().
+/** \brief Read the objects.txt of a dynvo_synthesize sequence: lines "timestamp id tx
+ * ty tz qx qy qz qw moving" (object-to-world, metres; moving 0 or 1), with the checks
+ * of readTrajectory().
  * \return the poses of each object id (1..255), by increasing stamp
  * \throws pcl::IOException "<file>:<line>: <problem>" on any violation or when the file
  *         cannot be opened
