@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // dynvo_evaluate GT EST: RPE and ATE of an estimated TUM trajectory against ground truth.
 // dynvo_evaluate -labels PRED_DIR -truth SEQ_DIR: segmentation scores of label PNGs.
+// dynvo_evaluate -objects_dir DIR -truth SEQ_DIR: RPE of object trajectories.
 #include <dynvo/app/cli.h>
+#include <dynvo/app/object_trajectories.h>
 #include <dynvo/app/segmentation_evaluation.h>
 #include <dynvo/eval/label_metrics.h>
 #include <dynvo/eval/trajectory_metrics.h>
@@ -18,7 +20,8 @@ namespace {
 
 const char* const USAGE =
     "dynvo_evaluate GROUNDTRUTH ESTIMATE [-delta D] [-delta_unit s|f] [-json]\n"
-    "       dynvo_evaluate -labels PRED_DIR -truth SEQ_DIR [-json]";
+    "       dynvo_evaluate -labels PRED_DIR -truth SEQ_DIR [-json]\n"
+    "       dynvo_evaluate -objects_dir DIR -truth SEQ_DIR [-json]";
 
 const char* const SEGMENTATION_HELP =
     "predicted labels (0 none, 1 static, 2.. objects) against SEQ_DIR/labels\n"
@@ -27,25 +30,42 @@ const char* const SEGMENTATION_HELP =
     "labelled bg_ok id_switch_rate frames; without SEQ_DIR/labels (a static\n"
     "recording) moving_share labelled frames. Definitions: README.md, dynvo_evaluate.";
 
-/// -labels selects the segmentation mode, which takes no positional arguments.
+const char* const OBJECTS_HELP =
+    "object_<id>.txt of a dynvo_odometry -objects_dir folder against the\n"
+    "true objects of a synthetic SEQ_DIR (objects.txt, groundtruth.txt). Each object "
+    "is\n"
+    "moved into the true world by the camera at its first frame, matched to the true\n"
+    "object whose origin is nearest on average (within 0.5 m), and scored by the\n"
+    "translational RPE (1 s pairs, m/s) of the path of its frame's origin, a fixed "
+    "point\n"
+    "of the object. Definitions: README.md, dynvo_evaluate.";
+
+/// -labels and -objects_dir select the modes that take no positional arguments.
 bool
-labelsMode(int argc, char** argv)
+hasFlag(int argc, char** argv, const std::string& flag)
 {
-  return std::any_of(argv + 1, argv + argc, [](const char* token) {
-    return std::string(token) == "-labels";
+  return std::any_of(argv + 1, argv + argc, [&](const char* token) {
+    return token == flag;
   });
+}
+
+/// Refuses -delta and -delta_unit (trajectory mode only) and a missing -truth.
+void
+checkFolderMode(const dynvo::app::Arguments& args, const std::string& mode)
+{
+  if (!args.has("truth"))
+    throw dynvo::app::UsageError("-" + mode + " needs -truth SEQ_DIR");
+  for (const char* trajectory_only : {"delta", "delta_unit"})
+    if (args.has(trajectory_only))
+      throw dynvo::app::UsageError(std::string("-") + trajectory_only +
+                                   " applies to trajectories, not to -" + mode);
 }
 
 /// The segmentation mode: scores of -labels against -truth.
 int
 evaluateLabels(const dynvo::app::Arguments& args)
 {
-  if (!args.has("truth"))
-    throw dynvo::app::UsageError("-labels needs -truth SEQ_DIR");
-  for (const char* trajectory_only : {"delta", "delta_unit"})
-    if (args.has(trajectory_only))
-      throw dynvo::app::UsageError(std::string("-") + trajectory_only +
-                                   " applies to trajectories, not to -labels");
+  checkFolderMode(args, "labels");
   const dynvo::SegmentationEvaluation result =
       dynvo::app::evaluateSegmentation(args.string("labels"), args.string("truth"));
   if (result.scores.frames < result.sequence_frames)
@@ -61,6 +81,19 @@ evaluateLabels(const dynvo::app::Arguments& args)
   return 0;
 }
 
+/// The object mode: object trajectories of -objects_dir against -truth.
+int
+evaluateObjects(const dynvo::app::Arguments& args)
+{
+  checkFolderMode(args, "objects_dir");
+  if (args.has("labels"))
+    throw dynvo::app::UsageError("give -labels or -objects_dir, not both");
+  const auto scores =
+      dynvo::app::evaluateObjects(args.string("objects_dir"), args.string("truth"));
+  std::printf("%s\n", dynvo::app::formatObjectScores(scores, args.has("json")).c_str());
+  return 0;
+}
+
 } // namespace
 
 int
@@ -68,7 +101,8 @@ main(int argc, char** argv)
 {
   return dynvo::app::runApp(USAGE, [&] {
     const dynvo::RpeOptions defaults;
-    const bool labels = labelsMode(argc, argv);
+    const bool labels = hasFlag(argc, argv, "-labels");
+    const bool objects = hasFlag(argc, argv, "-objects_dir");
     const dynvo::app::Arguments args(
         argc, argv,
         {{"delta", "D", "RPE pair spacing (default 1)"},
@@ -76,9 +110,11 @@ main(int argc, char** argv)
          {"json", "", "print the result as one JSON object"},
          {"labels", "DIR",
           "predicted label PNGs <stamp>.png (dynvo_odometry -labels_dir)"},
+         {"objects_dir", "DIR", "object trajectories (dynvo_odometry -objects_dir)"},
          {"truth", "DIR",
-          "sequence folder scored against (labels/, depth.txt, rgb.txt)"}},
-        labels ? 0 : 2);
+          "sequence folder scored against (labels/, depth.txt, rgb.txt; objects.txt, "
+          "groundtruth.txt)"}},
+        labels || objects ? 0 : 2);
     if (args.helpRequested()) {
       std::printf(
           "Usage: %s\n\nRelative pose error as TUM evaluate_rpe.py --fixed_delta "
@@ -86,12 +122,15 @@ main(int argc, char** argv)
           "trajectories (timestamp tx ty tz qx qy qz qw, camera-to-world).\n\n%s",
           USAGE, args.optionsHelp().c_str());
       std::printf("\nWith -labels: %s\n", SEGMENTATION_HELP);
+      std::printf("\nWith -objects_dir: %s\n", OBJECTS_HELP);
       return 0;
     }
+    if (objects)
+      return evaluateObjects(args);
     if (labels)
       return evaluateLabels(args);
     if (args.has("truth"))
-      throw dynvo::app::UsageError("-truth needs -labels PRED_DIR");
+      throw dynvo::app::UsageError("-truth needs -labels PRED_DIR or -objects_dir DIR");
     dynvo::RpeOptions options;
     options.delta = args.number("delta", defaults.delta);
     if (!(options.delta > 0.0))

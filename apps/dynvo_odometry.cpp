@@ -21,7 +21,7 @@ using dynvo::app::UsageError;
 
 const char* const USAGE =
     "dynvo_odometry (-tum_dir DIR | -pcd_dir DIR | -oni FILE) [-out trajectory.txt] "
-    "[-labels_dir DIR] [-objects FILE] [options]";
+    "[-labels_dir DIR] [-objects FILE] [-objects_dir DIR] [-clouds_dir DIR] [options]";
 
 const char* const ABOUT =
     "Estimates the camera trajectory of a recording with the static scene only (scene "
@@ -136,15 +136,14 @@ main(int argc, char** argv)
     if (args.has("init_gt") && groundtruth.empty())
       throw UsageError("-init_gt needs a -tum_dir folder with groundtruth.txt");
 
+    const auto paths = dynvo::app::runOutputPathsFromArguments(
+        args, args.string("out"), args.string("labels_dir"));
     auto source = dynvo::app::openFrameSource(args);
     dynvo::app::prepareRunOutputs(args, *source,
                                   {{"-out", args.string("out")},
                                    {"-labels_dir", args.string("labels_dir"), true},
-                                   {"-objects", args.string("objects")},
                                    {"-render_dir", args.string("render_dir"), true}});
-    dynvo::app::RunOutputs outputs(args.string("out"), args.string("labels_dir"),
-                                   args.string("objects"),
-                                   args.has("init_gt") ? &groundtruth : nullptr);
+    dynvo::app::RunOutputs outputs(paths, args.has("init_gt") ? &groundtruth : nullptr);
     RunRenderer renderer(args, options.intrinsics);
     // Whatever stops the run, what was computed is written.
     const auto end = dynvo::app::runPipeline(

@@ -2,6 +2,7 @@
 // dynvo_render: label-coloured PNGs of a finished run, and its trajectory plot.
 #include <dynvo/app/cli.h>
 #include <dynvo/app/frame_source_args.h>
+#include <dynvo/app/object_trajectories.h>
 #include <dynvo/app/output_guard.h>
 #include <dynvo/common/timestamps.h>
 #include <dynvo/eval/trajectory_metrics.h>
@@ -30,7 +31,8 @@ using dynvo::app::UsageError;
 
 const char* const USAGE = "dynvo_render (-tum_dir DIR | -pcd_dir DIR | -oni FILE) "
                           "-trajectory FILE -labels_dir DIR "
-                          "-out_dir DIR [-groundtruth FILE] [-frames a,b,c | -every N] "
+                          "-out_dir DIR [-groundtruth FILE] [-objects_dir DIR] "
+                          "[-frames a,b,c | -every N] "
                           "[-view camera|oblique|top] "
                           "[-plot_plane xz|xy] [-blend B] [camera flags]";
 
@@ -117,6 +119,9 @@ main(int argc, char** argv)
           "where <stamp>_<view>.png and trajectory.png go (required)"},
          {"groundtruth", "FILE",
           "TUM ground truth: adds it and the error curve to the plot"},
+         {"objects_dir", "DIR",
+          "object trajectories of the run (dynvo_odometry -objects_dir): adds their "
+          "paths to the plot"},
          {"frames", "a,b,c", "frame indices to render (default: see -every)"},
          {"every", "N", "render every N-th frame (default 1)"},
          {"view", "camera|oblique|top", "viewpoint (default camera)"},
@@ -170,12 +175,17 @@ main(int argc, char** argv)
     const dynvo::Trajectory groundtruth =
         args.has("groundtruth") ? dynvo::readTrajectory(args.string("groundtruth"))
                                 : dynvo::Trajectory{};
+    std::vector<std::pair<int, dynvo::Trajectory>> objects;
+    if (args.has("objects_dir"))
+      for (auto& track :
+           dynvo::app::readObjectsFolder(args.string("objects_dir")).objects)
+        objects.emplace_back(track.id, std::move(track.poses));
     const auto source = dynvo::app::openFrameSource(args);
     const fs::path out_dir = args.string("out_dir");
     const fs::path labels_dir = args.string("labels_dir");
     auto inputs = source->inputPaths();
     inputs.insert(inputs.end(), {args.string("trajectory"), args.string("groundtruth"),
-                                 labels_dir.string()});
+                                 labels_dir.string(), args.string("objects_dir")});
     dynvo::app::prepareOutputs({{"-out_dir", out_dir.string(), true}}, inputs);
     std::string reason;
     if (!dynvo::displayAvailable(&reason)) {
@@ -225,11 +235,20 @@ main(int argc, char** argv)
             throw std::runtime_error(image + ": rendering failed");
           render_ms.push_back(timer.toc());
         });
-    if (!groundtruth.empty())
-      estimate = dynvo::alignToGroundTruth(groundtruth, estimate);
-    if (!estimate.empty() &&
-        !dynvo::writeTrajectoryPlot(estimate, groundtruth,
-                                    (out_dir / "trajectory.png").string(), plot))
+    if (!groundtruth.empty() && !estimate.empty()) {
+      // The objects are in the estimate's world: they move with it (a rigid map).
+      const dynvo::Trajectory aligned =
+          dynvo::alignToGroundTruth(groundtruth, estimate);
+      const Eigen::Isometry3d T_aligned_estimate =
+          aligned.front().T_world_camera * estimate.front().T_world_camera.inverse();
+      for (auto& [id, object] : objects)
+        for (auto& pose : object)
+          pose.T_world_camera = T_aligned_estimate * pose.T_world_camera;
+      estimate = aligned;
+    }
+    if (!estimate.empty() && !dynvo::writeTrajectoryPlot(
+                                 estimate, groundtruth,
+                                 (out_dir / "trajectory.png").string(), plot, objects))
       return 1;
 
     printSummary(render_ms, out_dir.string());

@@ -9,7 +9,7 @@ namespace {
 
 const char* const USAGE =
     "dynvo_segment (-tum_dir DIR | -pcd_dir DIR | -oni FILE) -out_dir LABELS "
-    "[-objects FILE] [options]";
+    "[-objects FILE] [-objects_dir DIR] [-clouds_dir DIR] [options]";
 
 const char* const ABOUT =
     "Labels every frame by rigid motion: 0 no measurement, 1 static background, 2.. "
@@ -40,11 +40,12 @@ main(int argc, char** argv)
       throw dynvo::app::UsageError("-out_dir DIR is required");
     const std::size_t max_frames = dynvo::app::maxFramesFromArguments(args);
 
+    const auto paths =
+        dynvo::app::runOutputPathsFromArguments(args, "", args.string("out_dir"));
     const auto source = dynvo::app::openFrameSource(args);
     dynvo::app::prepareRunOutputs(args, *source,
-                                  {{"-out_dir", args.string("out_dir"), true},
-                                   {"-objects", args.string("objects")}});
-    dynvo::app::RunOutputs outputs("", args.string("out_dir"), args.string("objects"));
+                                  {{"-out_dir", args.string("out_dir"), true}});
+    dynvo::app::RunOutputs outputs(paths);
     // Whatever stops the run, the labels and objects of the frames done are kept.
     const auto end = dynvo::app::runPipeline(options, max_frames, *source, outputs);
     end.report.printSummary();

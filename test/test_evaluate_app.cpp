@@ -267,4 +267,99 @@ TEST_F(EvaluateLabels, UsageErrorsExitTwo)
   EXPECT_NE(help.out.find("-labels PRED_DIR -truth SEQ_DIR"), std::string::npos);
 }
 
+/// A synthetic sequence's truth (groundtruth.txt, objects.txt) and a hand-made objects
+/// folder: the estimate is the truth in another world (A: the camera at frame 0) with
+/// other object frames, so its object 4 tracks true object 2 exactly.
+class EvaluateObjects : public ::testing::Test {
+protected:
+  static Eigen::Isometry3d trueObject(int id, double t)
+  {
+    return Eigen::Translation3d(id == 1 ? -1.0 : 0.2 + 0.3 * t, 0.1 * id,
+                                2.0 + 0.1 * t) *
+           Eigen::AngleAxisd(0.5 * t * id, Eigen::Vector3d(0.2, 1.0, 0.1).normalized());
+  }
+
+  void SetUp() override
+  {
+    std::filesystem::create_directories(dir_.file("seq"));
+    std::filesystem::create_directories(dir_.file("objects"));
+    dynvo::Trajectory camera_truth, camera_estimate, object_4, far_away;
+    std::string objects = "# timestamp id tx ty tz qx qy qz qw moving\n";
+    const Eigen::Isometry3d A(Eigen::Translation3d(0.1, -0.2, 0.3) *
+                              Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY()));
+    const Eigen::Isometry3d B(Eigen::Translation3d(0.05, -0.1, -0.2) *
+                              Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitX()));
+    for (int k = 0; k < 60; ++k) { // 2 s at 30 Hz
+      const double t = 1.0 + k / 30.0;
+      const Eigen::Isometry3d camera =
+          A * Eigen::Translation3d(0.05 * k / 30.0, 0.0, 0.0);
+      camera_truth.push_back({t, camera});
+      camera_estimate.push_back({t, A.inverse() * camera});
+      for (int id : {1, 2}) {
+        std::string line = dynvo::formatTumLine({t, trueObject(id, t)});
+        line.insert(line.find(' '), " " + std::to_string(id));
+        objects += line + " 1\n";
+      }
+      if (k >= 5)
+        object_4.push_back({t, A.inverse() * trueObject(2, t) * B});
+      if (k >= 10 && k < 20) // 3 m from every object, tracked under 1 s
+        far_away.push_back({t, Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.0, 5.0))});
+    }
+    dynvo::writeTrajectory(dir_.file("seq/groundtruth.txt"), camera_truth);
+    dynvo::test::writeText(dir_.file("seq/objects.txt"), objects);
+    dynvo::writeTrajectory(dir_.file("objects/camera.txt"), camera_estimate);
+    dynvo::writeTrajectory(dir_.file("objects/object_4_1.txt"), object_4);
+    dynvo::writeTrajectory(dir_.file("objects/object_7_2.txt"), far_away);
+    dynvo::test::writeText(
+        dir_.file("objects/objects_summary.txt"),
+        "# id run first_stamp last_stamp frames_seen frames_moving "
+        "mean_speed path_length\n4 1 0 0 55 0 0 0\n7 2 0 0 10 0 0 0\n");
+  }
+
+  TempDir dir_;
+  const std::string app_ = DYNVO_EVALUATE_BIN;
+};
+
+TEST_F(EvaluateObjects, ScoresEachObjectAgainstTheNearestTrueObject)
+{
+  const auto result = runCommand(app_ + " -objects_dir " + dir_.file("objects") +
+                                 " -truth " + dir_.file("seq"));
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  // Object 4 is true object 2 seen from another world with another object frame: zero
+  // error (the files hold 9 decimals). Its origin is B's offset (0.23 m) from the true
+  // object's. 55 frames over 1.8 s: the 1 s pairs of its first 24 frames.
+  EXPECT_TRUE(std::regex_search(
+      result.out,
+      std::regex(
+          "object=4 run=1 truth=2 frames=55 seconds=1.8[0-9]* distance=0.229[0-9]* "
+          "rpe_trans_rmse=0.00000[0-9] pairs=24\n")))
+      << result.out;
+  EXPECT_NE(result.out.find("object=7 run=2 truth=none frames=10 "), std::string::npos)
+      << result.out;
+  EXPECT_TRUE(std::regex_search(
+      result.out, std::regex("objects=2 scored=1 max_rpe_trans_rmse=0.00000[0-9]\n")))
+      << result.out;
+  const auto json = runCommand(app_ + " -json -objects_dir " + dir_.file("objects") +
+                               " -truth " + dir_.file("seq"));
+  ASSERT_EQ(json.exit_code, 0) << json.err;
+  EXPECT_NE(json.out.find("\"object\": 7, \"run\": 2, \"truth\": null"),
+            std::string::npos)
+      << json.out;
+  EXPECT_NE(json.out.find("\"scored\": 1"), std::string::npos) << json.out;
+}
+
+TEST_F(EvaluateObjects, UsageAndInputErrors)
+{
+  const std::string objects = " -objects_dir " + dir_.file("objects");
+  const std::string truth = " -truth " + dir_.file("seq");
+  EXPECT_EQ(runCommand(app_ + objects).exit_code, 2);
+  EXPECT_EQ(runCommand(app_ + objects + truth + " -delta 2").exit_code, 2);
+  EXPECT_EQ(runCommand(app_ + objects + truth + " -labels " + dir_.file("x")).exit_code,
+            2);
+  std::filesystem::remove(dir_.file("seq/objects.txt"));
+  const auto missing = runCommand(app_ + objects + truth);
+  EXPECT_EQ(missing.exit_code, 1);
+  EXPECT_NE(missing.err.find("objects.txt"), std::string::npos) << missing.err;
+}
+
 } // namespace

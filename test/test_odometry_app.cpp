@@ -1,8 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // dynvo_odometry as users run it: outputs, closing lines, determinism and bad input.
+#include <dynvo/app/object_trajectories.h>
 #include <dynvo/app/pipeline_config.h>
 #include <dynvo/io/label_io.h>
 #include <dynvo/io/trajectory_io.h>
+
+#include <pcl/io/pcd_io.h>
+#include <pcl/point_types.h>
 
 #include <gtest/gtest.h>
 
@@ -13,6 +17,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <regex>
 #include <sstream>
 
@@ -168,11 +173,161 @@ TEST_F(OdometryApp, CorruptFrameStopsTheRunButKeepsWhatWasComputed)
   EXPECT_EQ(dynvo::readTrajectory(out_.file("t.txt")).size(), 6u);
 }
 
+TEST_F(OdometryApp, CloudsAreLabelledPcdsOfEveryNthFrame)
+{
+  const auto result = runCommand(
+      run("-max_frames 12 -labels_dir " + out_.file("labels") + " -clouds_dir " +
+          out_.file("clouds") + " -clouds_every 5 -out " + out_.file("t.txt")));
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const auto trajectory = dynvo::readTrajectory(out_.file("t.txt"));
+  ASSERT_EQ(trajectory.size(), 12u);
+  std::size_t clouds = 0;
+  for (const auto& entry : fs::directory_iterator(out_.file("clouds"))) {
+    EXPECT_EQ(entry.path().extension(), ".pcd") << entry.path();
+    ++clouds;
+  }
+  EXPECT_EQ(clouds, 3u); // frames 0, 5 and 10
+  const std::string stamp = dynvo::formatStamp(trajectory[5].timestamp);
+  const std::string file = out_.file("clouds") + "/" + stamp + ".pcd";
+  EXPECT_NE(dynvo::test::readText(file).find("\nDATA binary_compressed\n"),
+            std::string::npos);
+  pcl::PointCloud<pcl::PointXYZRGBL> cloud;
+  ASSERT_EQ(pcl::io::loadPCDFile(file, cloud), 0);
+  EXPECT_EQ(cloud.width, 640u);
+  EXPECT_EQ(cloud.height, 480u);
+  EXPECT_TRUE(cloud.isOrganized());
+  // Every point carries the label of its pixel in the frame's PNG, byte for byte.
+  const auto labels =
+      dynvo::readLabelImage(out_.file("labels") + "/" + stamp + ".png").data;
+  ASSERT_EQ(labels.size(), cloud.size());
+  std::size_t mismatched = 0, labelled = 0, finite_unlabelled = 0;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    mismatched += cloud[i].label != labels[i] ? 1 : 0;
+    labelled += labels[i] != 0 ? 1 : 0;
+    // The cloud is the input frame: a pixel with a label has depth.
+    finite_unlabelled += labels[i] != 0 && !std::isfinite(cloud[i].z) ? 1 : 0;
+  }
+  EXPECT_EQ(mismatched, 0u);
+  EXPECT_GT(labelled,
+            cloud.size() / 2); // the README: about 90 % labelled on static_one
+  EXPECT_EQ(finite_unlabelled, 0u);
+}
+
+/// Runs of consecutive frames per id in an objects file: id -> (first, last frame
+/// index).
+std::multimap<int, std::pair<std::size_t, std::size_t>>
+objectRuns(const std::string& objects_file, const dynvo::Trajectory& trajectory)
+{
+  std::map<double, std::size_t> frame_of;
+  for (std::size_t k = 0; k < trajectory.size(); ++k)
+    frame_of[std::round(trajectory[k].timestamp * 1e6)] = k;
+  std::map<int, std::vector<std::size_t>> frames;
+  std::ifstream in(objects_file);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#')
+      continue;
+    std::istringstream fields(line);
+    double stamp = 0.0;
+    int id = 0;
+    fields >> stamp >> id;
+    frames[id].push_back(frame_of.at(std::round(stamp * 1e6)));
+  }
+  std::multimap<int, std::pair<std::size_t, std::size_t>> runs;
+  for (const auto& [id, list] : frames)
+    for (std::size_t i = 0; i < list.size(); ++i)
+      if (i == 0 || list[i] != list[i - 1] + 1)
+        runs.insert({id, {list[i], list[i]}});
+      else
+        std::prev(runs.end())->second.second = list[i];
+  return runs;
+}
+
+TEST_F(OdometryApp, ObjectTrajectoriesFollowTheMotionsOfTheObjectsFile)
+{
+  const auto result =
+      runCommand(run("-out " + out_.file("t.txt") + " -objects " + out_.file("o.txt") +
+                     " -objects_dir " + out_.file("objects")));
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const auto trajectory = dynvo::readTrajectory(out_.file("t.txt"));
+  const auto folder = dynvo::app::readObjectsFolder(out_.file("objects"));
+  // camera.txt is the run's trajectory.
+  EXPECT_EQ(dynvo::test::readText(out_.file("objects") + "/camera.txt"),
+            dynvo::test::readText(out_.file("t.txt")));
+  // One track per run of consecutive frames of an id in the -objects file.
+  const auto runs = objectRuns(out_.file("o.txt"), trajectory);
+  ASSERT_FALSE(folder.objects.empty());
+  ASSERT_EQ(folder.objects.size(), runs.size());
+  for (const auto& track : folder.objects) {
+    auto range = runs.equal_range(track.id);
+    ASSERT_GE(std::distance(range.first, range.second), track.run) << track.id;
+    const auto [first, last] = std::next(range.first, track.run - 1)->second;
+    ASSERT_EQ(track.poses.size(), last - first + 1) << track.id;
+    EXPECT_NEAR(track.poses.front().timestamp, trajectory[first].timestamp, 1e-6);
+    EXPECT_NEAR(track.poses.back().timestamp, trajectory[last].timestamp, 1e-6);
+    // The object frame has the camera's axes at the run's first frame.
+    EXPECT_TRUE(track.poses.front().T_world_camera.linear().isApprox(
+        trajectory[first].T_world_camera.linear(), 1e-6));
+    // Its origin, a centroid of the frame's points, lies within the sensor's range
+    // (0.5-4.5 m in front of the camera).
+    const double z = (trajectory[first].T_world_camera.inverse() *
+                      track.poses.front().T_world_camera)
+                         .translation()
+                         .z();
+    EXPECT_GT(z, 0.5);
+    EXPECT_LT(z, 4.5);
+  }
+  // Each later pose is T_world_curr * T_curr_prev * inv(T_world_prev) * the previous
+  // one, with the motions of the -objects file (translations to 1 um, quaternions to
+  // 1e-9: over 4 m of lever arm below 1e-5 m per step).
+  std::map<std::pair<double, int>, Eigen::Isometry3d> motions;
+  std::ifstream in(out_.file("o.txt"));
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#')
+      continue;
+    std::istringstream fields(line);
+    double stamp, pixels, tx, ty, tz, qx, qy, qz, qw;
+    int id;
+    fields >> stamp >> id >> pixels >> tx >> ty >> tz >> qx >> qy >> qz >> qw;
+    Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
+    motion.linear() =
+        Eigen::Quaterniond(qw, qx, qy, qz).normalized().toRotationMatrix();
+    motion.translation() = Eigen::Vector3d(tx, ty, tz);
+    motions[{std::round(stamp * 1e6), id}] = motion;
+  }
+  std::size_t steps = 0;
+  for (const auto& track : folder.objects) {
+    const std::size_t first =
+        std::next(runs.equal_range(track.id).first, track.run - 1)->second.first;
+    for (std::size_t i = 1; i < track.poses.size(); ++i) {
+      const std::size_t k = first + i;
+      const Eigen::Isometry3d expected =
+          trajectory[k].T_world_camera *
+          motions.at({std::round(trajectory[k].timestamp * 1e6), track.id}) *
+          trajectory[k - 1].T_world_camera.inverse() *
+          track.poses[i - 1].T_world_camera;
+      EXPECT_LT(
+          (expected.translation() - track.poses[i].T_world_camera.translation()).norm(),
+          1e-5);
+      ++steps;
+    }
+  }
+  EXPECT_GT(steps, 0u);
+}
+
 TEST_F(OdometryApp, BadFlagsAndMissingInput)
 {
   EXPECT_EQ(runCommand(run("-bogus")).exit_code, 2);
   EXPECT_EQ(runCommand(run("-refine lm")).exit_code, 2);
   EXPECT_EQ(runCommand(run("-threads 0")).exit_code, 2);
+  const auto every =
+      runCommand(run("-clouds_dir " + out_.file("c") + " -clouds_every 0"));
+  EXPECT_EQ(every.exit_code, 2);
+  EXPECT_NE(every.err.find("-clouds_every"), std::string::npos) << every.err;
+  EXPECT_EQ(runCommand(run("-clouds_every 2")).exit_code, 2); // without -clouds_dir
+  EXPECT_FALSE(fs::exists(out_.file("c")));
+  EXPECT_EQ(runCommand(run("-objects_dir " + sequence_->path() + "/rgb")).exit_code, 2);
   EXPECT_EQ(runCommand(app_ + " -out x.txt").exit_code, 2); // no source
   const auto missing = runCommand(app_ + " -tum_dir " + out_.file("none"));
   EXPECT_EQ(missing.exit_code, 1);

@@ -447,4 +447,46 @@ TEST(TrajectoryPlot, CurvesAreInsideTheirPlotAreas)
   }
 }
 
+TEST(TrajectoryPlot, ObjectPathsAreDrawnInTheirLabelColours)
+{
+  DYNVO_SKIP_WITHOUT_DISPLAY();
+  // The camera moves 1 m along x; object 2 crosses 1 m along z in front of it, object 3
+  // (a second run of another id) moves 0.5 m along x further away.
+  dynvo::Trajectory estimate, crossing, far;
+  for (int k = 0; k <= 90; ++k) {
+    const double t = k / 90.0;
+    dynvo::StampedPose pose;
+    pose.timestamp = 1.0 + k / 30.0;
+    pose.T_world_camera.translation() = Eigen::Vector3d(t, 0.0, 0.0);
+    estimate.push_back(pose);
+    pose.T_world_camera.translation() = Eigen::Vector3d(0.5, 0.0, 1.0 + t);
+    crossing.push_back(pose);
+    pose.T_world_camera.translation() = Eigen::Vector3d(0.25 + 0.5 * t, 0.0, 2.5);
+    far.push_back(pose);
+  }
+  dynvo::test::TempDir dir;
+  const dynvo::TrajectoryPlotOptions options;
+  ASSERT_TRUE(dynvo::writeTrajectoryPlot(estimate, {}, dir.file("plot.png"), options,
+                                         {{2, crossing}, {3, far}}));
+  const cv::Mat image = cv::imread(dir.file("plot.png"), cv::IMREAD_COLOR);
+  ASSERT_EQ(image.cols, int(options.width));
+  // Without ground truth the path chart takes the whole width, its legend (with a
+  // sample of each colour) in the top-right corner. Each object's path is a line in its
+  // label's palette colour: the crossing one vertical (along z), the far one horizontal
+  // (along x) and above the crossing one (larger z).
+  const int tolerance = 40; // anti-aliased line edges, as above
+  const int left_of_legend = image.cols * 4 / 5;
+  int count2 = 0, count3 = 0;
+  const cv::Rect box2 = colourBox(image, dynvo::LabelRenderer::labelColor(2), 0,
+                                  left_of_legend, tolerance, &count2);
+  const cv::Rect box3 = colourBox(image, dynvo::LabelRenderer::labelColor(3), 0,
+                                  left_of_legend, tolerance, &count3);
+  // A 2-px line over a third of the chart is over a hundred pixels.
+  EXPECT_GT(count2, 100);
+  EXPECT_GT(count3, 100);
+  EXPECT_GT(box2.height, 3 * box2.width) << box2;
+  EXPECT_GT(box3.width, 3 * box3.height) << box3;
+  EXPECT_LT(box3.y + box3.height, box2.y + 5); // image rows grow downwards
+}
+
 } // namespace

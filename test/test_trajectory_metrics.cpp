@@ -158,4 +158,39 @@ TEST(TrajectoryMetricsRealData, Fr1GroundTruthAgainstDriftingCopy)
   EXPECT_LE(ate.rmse, v * span / std::sqrt(12.0) + 1e-6);
 }
 
+TEST(ObjectRpe, FixedOffsetsOfWorldAndObjectFrameScoreZero)
+{
+  // The estimate is the true object seen from another world (A) with another object
+  // frame (B: a point on its surface, other axes). Plain RPE of the poses is not
+  // invariant to B once the object rotates; the point path is.
+  const Eigen::Isometry3d A = Eigen::Translation3d(0.5, -0.2, 1.0) *
+                              Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitY());
+  const Eigen::Isometry3d B = Eigen::Translation3d(0.1, -0.15, 0.2) *
+                              Eigen::AngleAxisd(-0.4, Eigen::Vector3d::UnitX());
+  const auto truth = sample(4.0, wobble);
+  const auto estimate = sample(4.0, [&](double t) {
+    return A * wobble(t) * B;
+  });
+  EXPECT_GT(dynvo::computeRpe(truth, estimate).trans_rmse, 0.01); // B matters for RPE
+  const auto rpe = dynvo::computeObjectRpe(truth, estimate, A.inverse());
+  EXPECT_GT(rpe.pairs, 0u);
+  EXPECT_NEAR(rpe.trans_rmse, 0.0, 1e-9);
+}
+
+TEST(ObjectRpe, DriftOfTheObjectPathIsItsRate)
+{
+  // The estimated path drifts 2 cm/s along x: every 1 s pair is off by 2 cm.
+  const Eigen::Isometry3d B(Eigen::Translation3d(0.05, 0.0, -0.1));
+  const auto truth = sample(4.0, wobble);
+  const auto estimate = sample(4.0, [&](double t) {
+    return Eigen::Translation3d(0.02 * t, 0.0, 0.0) * wobble(t) * B;
+  });
+  const auto rpe =
+      dynvo::computeObjectRpe(truth, estimate, Eigen::Isometry3d::Identity());
+  EXPECT_NEAR(rpe.trans_rmse, 0.02, 1e-6); // the 1 s pairs span 30 frames exactly
+  EXPECT_DOUBLE_EQ(rpe.rot_rmse, 0.0);
+  EXPECT_THROW(dynvo::computeObjectRpe(truth, {}, Eigen::Isometry3d::Identity()),
+               std::invalid_argument);
+}
+
 } // namespace

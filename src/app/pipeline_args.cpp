@@ -163,6 +163,14 @@ appOptions(PipelineStages stages, std::vector<Option> own)
     options.push_back(
         {"objects", "FILE",
          "write 'timestamp id n_pixels tx ty tz qx qy qz qw' per object"});
+    options.push_back({"objects_dir", "DIR",
+                       "write object_<id>.txt (object-to-world), camera.txt and "
+                       "objects_summary.txt"});
+    options.push_back(
+        {"clouds_dir", "DIR",
+         "write <stamp>.pcd per frame: PointXYZRGBL, label as in the PNGs"});
+    options.push_back(
+        {"clouds_every", "N", "write the cloud of every N-th frame (default 1)"});
   }
   options.push_back({"v", "", "verbose (PCL debug messages)"});
   options.push_back({"q", "", "quiet (errors only)"});
@@ -223,11 +231,32 @@ writeConfigIfRequested(const Arguments& args, const PipelineOptions& options)
 void
 prepareRunOutputs(const Arguments& args,
                   const FrameSource& source,
-                  const std::vector<OutputPath>& outputs)
+                  std::vector<OutputPath> outputs)
 {
   auto inputs = source.inputPaths();
   inputs.push_back(args.string("config"));
+  outputs.insert(outputs.end(), {{"-objects", args.string("objects")},
+                                 {"-objects_dir", args.string("objects_dir"), true},
+                                 {"-clouds_dir", args.string("clouds_dir"), true}});
   prepareOutputs(outputs, inputs);
+}
+
+RunOutputPaths
+runOutputPathsFromArguments(const Arguments& args,
+                            const std::string& trajectory,
+                            const std::string& labels_dir)
+{
+  if (args.has("clouds_every") && !args.has("clouds_dir"))
+    throw UsageError("-clouds_every needs -clouds_dir DIR");
+  RunOutputPaths paths;
+  paths.trajectory = trajectory;
+  paths.labels_dir = labels_dir;
+  paths.objects = args.string("objects");
+  paths.clouds_dir = args.string("clouds_dir");
+  paths.clouds_every = static_cast<std::size_t>(
+      args.integer("clouds_every", 1, 1, std::numeric_limits<long>::max()));
+  paths.objects_dir = args.string("objects_dir");
+  return paths;
 }
 
 std::size_t
@@ -250,7 +279,7 @@ runPipeline(const PipelineOptions& options,
       RunReport(max_frames > 0 ? std::min(max_frames, source.size()) : source.size())};
   end.loop = processFrames(source, max_frames, [&](const Frame& frame) {
     const auto& result = pipeline.process(frame.cloud, frame.timestamp);
-    outputs.add(result);
+    outputs.add(frame, result);
     if (on_result)
       on_result(frame, result);
     end.report.add(result);

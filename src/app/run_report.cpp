@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <numeric>
+#include <stdexcept>
 #include <unistd.h>
 
 namespace dynvo::app {
@@ -31,32 +32,33 @@ median(std::vector<double> values)
 
 } // namespace
 
-RunOutputs::RunOutputs(const std::string& trajectory_path,
-                       const std::string& labels_dir,
-                       const std::string& objects_path,
+RunOutputs::RunOutputs(const RunOutputPaths& paths,
                        const Trajectory* initial_groundtruth)
-    : trajectory_path_(trajectory_path)
-    , labels_dir_(labels_dir)
-    , objects_path_(objects_path)
+    : paths_(paths)
     , initial_groundtruth_(initial_groundtruth)
 {
-  if (!labels_dir_.empty()) {
+  if (paths_.clouds_every < 1)
+    throw std::invalid_argument("[dynvo::app::RunOutputs] clouds_every must be >= 1");
+  for (const std::string& folder :
+       {paths_.labels_dir, paths_.clouds_dir, paths_.objects_dir}) {
+    if (folder.empty())
+      continue;
     std::error_code error;
-    fs::create_directories(labels_dir_, error);
-    if (error || !fs::is_directory(labels_dir_))
-      throw pcl::IOException(labels_dir_ + ": cannot create the labels folder");
+    fs::create_directories(folder, error);
+    if (error || !fs::is_directory(folder))
+      throw pcl::IOException(folder + ": cannot create the output folder");
   }
-  if (!objects_path_.empty()) {
-    objects_file_ = std::make_unique<PartialFile>(objects_path_);
+  if (!paths_.objects.empty()) {
+    objects_file_ = std::make_unique<PartialFile>(paths_.objects);
     objects_.open(objects_file_->partialPath(), std::ios::trunc);
     if (!objects_)
-      throw pcl::IOException(objects_path_ + ": cannot write objects file");
+      throw pcl::IOException(paths_.objects + ": cannot write objects file");
     objects_ << "# timestamp id n_pixels tx ty tz qx qy qz qw (T_curr_prev, metres)\n";
   }
 }
 
 void
-RunOutputs::add(const FrameResult& result)
+RunOutputs::add(const Frame& frame, const FrameResult& result)
 {
   if (trajectory_.empty() && initial_groundtruth_ && !initial_groundtruth_->empty()) {
     std::vector<double> stamps;
@@ -71,9 +73,20 @@ RunOutputs::add(const FrameResult& result)
   trajectory_.push_back(pose);
 
   // A frame the pipeline could not process (result.error) has no image to label.
-  if (!labels_dir_.empty() && result.error.empty())
-    writeLabelImage((fs::path(labels_dir_) / stampedPngName(result.timestamp)).string(),
-                    {result.width, result.height, result.labels});
+  if (result.error.empty()) {
+    if (!paths_.labels_dir.empty())
+      writeLabelImage(
+          (fs::path(paths_.labels_dir) / stampedPngName(result.timestamp)).string(),
+          {result.width, result.height, result.labels});
+    if (!paths_.clouds_dir.empty() &&
+        (trajectory_.size() - 1) % paths_.clouds_every == 0)
+      writeLabelledCloud(
+          (fs::path(paths_.clouds_dir) / (formatStamp(result.timestamp) + ".pcd"))
+              .string(),
+          *frame.cloud, result.labels);
+    if (!paths_.objects_dir.empty())
+      object_trajectories_.add(result, *frame.cloud, pose.T_world_camera);
+  }
   if (objects_.is_open()) {
     for (std::size_t s = 1; s < result.segments.size(); ++s)
       objects_ << formatObjectMotionLine(result.timestamp, result.segment_labels[s],
@@ -81,7 +94,7 @@ RunOutputs::add(const FrameResult& result)
                                          result.motions[s])
                << '\n';
     if (!objects_)
-      throw pcl::IOException(objects_path_ + ": write failed");
+      throw pcl::IOException(paths_.objects + ": write failed");
   }
 }
 
@@ -91,12 +104,14 @@ RunOutputs::finish()
   // Nothing computed: every existing file stays as it was (the partial file goes).
   if (trajectory_.empty())
     return;
-  if (!trajectory_path_.empty())
-    writeTrajectory(trajectory_path_, trajectory_);
+  if (!paths_.trajectory.empty())
+    writeTrajectory(paths_.trajectory, trajectory_);
+  if (!paths_.objects_dir.empty())
+    writeObjectsFolder(paths_.objects_dir, object_trajectories_.tracks(), trajectory_);
   if (objects_file_) {
     objects_.close();
     if (!objects_)
-      throw pcl::IOException(objects_path_ + ": write failed");
+      throw pcl::IOException(paths_.objects + ": write failed");
     objects_file_->commit();
   }
 }

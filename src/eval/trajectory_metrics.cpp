@@ -98,6 +98,38 @@ computeRpe(const Trajectory& groundtruth,
   return result;
 }
 
+RpeResult
+computeObjectRpe(const Trajectory& truth,
+                 const Trajectory& estimate,
+                 const Eigen::Isometry3d& T_truth_estimate,
+                 const RpeOptions& options)
+{
+  if (estimate.empty())
+    throw std::invalid_argument("[dynvo::computeObjectRpe] the estimate is empty");
+  // 0.1 s: three frames at 30 Hz; the truth of a synthetic sequence has every frame.
+  const auto first = interpolatePose(truth, estimate.front().timestamp, 0.1);
+  if (!first)
+    throw std::invalid_argument("[dynvo::computeObjectRpe] no true pose at the "
+                                "estimate's first stamp");
+  const Eigen::Vector3d b =
+      first->inverse() *
+      (T_truth_estimate * estimate.front().T_world_camera.translation());
+  const auto points = [](const Trajectory& poses, const Eigen::Isometry3d& T_world_pose,
+                         const Eigen::Vector3d& point) {
+    Trajectory path;
+    for (const StampedPose& pose : poses) {
+      StampedPose position{pose.timestamp, Eigen::Isometry3d::Identity()};
+      position.T_world_camera.translation() =
+          T_world_pose * pose.T_world_camera * point;
+      path.push_back(position);
+    }
+    return path;
+  };
+  return computeRpe(points(truth, Eigen::Isometry3d::Identity(), b),
+                    points(estimate, T_truth_estimate, Eigen::Vector3d::Zero()),
+                    options);
+}
+
 AteResult
 computeAte(const Trajectory& groundtruth,
            const Trajectory& estimate,

@@ -6,6 +6,8 @@
 #include "image_file.h"
 
 #include <pcl/exceptions.h>
+#include <pcl/common/io.h>
+#include <pcl/io/pcd_io.h>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -13,6 +15,7 @@
 #include <Eigen/Geometry>
 
 #include <cstdio>
+#include <stdexcept>
 
 namespace dynvo {
 
@@ -91,6 +94,25 @@ formatObjectMotionLine(double timestamp,
   std::snprintf(line, sizeof(line), "%.6f %d %zu %.6f %.6f %.6f %.9f %.9f %.9f %.9f",
                 timestamp, id, pixels, t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
   return line;
+}
+
+void
+writeLabelledCloud(const std::string& path,
+                   const pcl::PointCloud<pcl::PointXYZRGB>& cloud,
+                   const std::vector<std::uint8_t>& labels)
+{
+  if (labels.size() != cloud.size())
+    throw std::invalid_argument("[dynvo::writeLabelledCloud] " +
+                                std::to_string(labels.size()) + " labels for " +
+                                std::to_string(cloud.size()) + " points");
+  pcl::PointCloud<pcl::PointXYZRGBL> labelled;
+  pcl::copyPointCloud(cloud, labelled);
+  for (std::size_t i = 0; i < labels.size(); ++i)
+    labelled[i].label = labels[i];
+  PartialFile file(path);
+  if (pcl::io::savePCDFileBinaryCompressed(file.partialPath(), labelled) != 0)
+    throw pcl::IOException(path + ": cannot write the labelled cloud");
+  file.commit();
 }
 
 } // namespace dynvo

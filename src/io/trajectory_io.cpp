@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 
 namespace dynvo {
@@ -19,10 +20,36 @@ namespace {
 /// small enough that squared errors summed over millions of poses stay finite.
 constexpr double MAX_MAGNITUDE = 1e15;
 
-} // namespace
+/// The pose of values[first .. first + 6] (tx ty tz qx qy qz qw).
+/// \throws pcl::IOException "<where>quaternion norm ..." when the norm is not 1
+Eigen::Isometry3d
+poseOf(const std::vector<double>& values, std::size_t first, const std::string& where)
+{
+  Eigen::Quaterniond q(values[first + 6], values[first + 3], values[first + 4],
+                       values[first + 5]);
+  if (std::abs(q.norm() - 1.0) > 1e-3)
+    throw pcl::IOException(where + "quaternion norm " + std::to_string(q.norm()) +
+                           " is not 1 (tolerance 1e-3)");
+  q.normalize();
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = q.toRotationMatrix();
+  pose.translation() =
+      Eigen::Vector3d(values[first], values[first + 1], values[first + 2]);
+  return pose;
+}
 
-Trajectory
-readTrajectory(const std::string& path)
+/** \brief Calls on_line(values, where) for every line that is not blank or a '#'
+ * comment, after checking that it holds exactly `columns` finite numbers (commas count
+ * as blanks).
+ * \throws pcl::IOException "<file>:<line>: <problem>", or when the file cannot be
+ * opened
+ */
+void
+readNumberLines(
+    const std::string& path,
+    const char* columns_text,
+    std::size_t columns,
+    const std::function<void(const std::vector<double>&, const std::string&)>& on_line)
 {
   std::error_code error;
   if (std::filesystem::is_directory(path, error))
@@ -30,7 +57,6 @@ readTrajectory(const std::string& path)
   std::ifstream in(path);
   if (!in)
     throw pcl::IOException(path + ": cannot open trajectory file");
-  Trajectory trajectory;
   std::string line;
   for (int number = 1; std::getline(in, line); ++number) {
     const auto first = line.find_first_not_of(" \t\r");
@@ -54,27 +80,54 @@ readTrajectory(const std::string& path)
                                "' is out of range (magnitude above 1e15)");
       values.push_back(value);
     }
-    if (values.size() != 8)
-      throw pcl::IOException(where +
-                             "expected 8 numbers (timestamp tx ty tz qx qy qz "
-                             "qw), got " +
+    if (values.size() != columns)
+      throw pcl::IOException(where + "expected " + std::to_string(columns) +
+                             " numbers (" + columns_text + "), got " +
                              std::to_string(values.size()));
-    if (!trajectory.empty() && !(values[0] > trajectory.back().timestamp))
-      throw pcl::IOException(where + "timestamp " + std::to_string(values[0]) +
-                             " does not increase");
-    Eigen::Quaterniond q(values[7], values[4], values[5], values[6]);
-    if (std::abs(q.norm() - 1.0) > 1e-3)
-      throw pcl::IOException(where + "quaternion norm " + std::to_string(q.norm()) +
-                             " is not 1 (tolerance 1e-3)");
-    q.normalize();
-    StampedPose pose;
-    pose.timestamp = values[0];
-    pose.T_world_camera.linear() = q.toRotationMatrix();
-    pose.T_world_camera.translation() =
-        Eigen::Vector3d(values[1], values[2], values[3]);
-    trajectory.push_back(pose);
+    on_line(values, where);
   }
+}
+
+/// Appends a pose whose stamp must be later than the last one's.
+void
+appendPose(Trajectory& trajectory,
+           double stamp,
+           const Eigen::Isometry3d& pose,
+           const std::string& where)
+{
+  if (!trajectory.empty() && !(stamp > trajectory.back().timestamp))
+    throw pcl::IOException(where + "timestamp " + std::to_string(stamp) +
+                           " does not increase");
+  trajectory.push_back({stamp, pose});
+}
+
+} // namespace
+
+Trajectory
+readTrajectory(const std::string& path)
+{
+  Trajectory trajectory;
+  readNumberLines(path, "timestamp tx ty tz qx qy qz qw", 8,
+                  [&](const std::vector<double>& values, const std::string& where) {
+                    appendPose(trajectory, values[0], poseOf(values, 1, where), where);
+                  });
   return trajectory;
+}
+
+std::map<int, Trajectory>
+readObjectPoses(const std::string& path)
+{
+  std::map<int, Trajectory> objects;
+  readNumberLines(path, "timestamp id tx ty tz qx qy qz qw moving", 10,
+                  [&](const std::vector<double>& values, const std::string& where) {
+                    const double id = values[1];
+                    if (!(id >= 1.0 && id <= 255.0 && id == std::floor(id)))
+                      throw pcl::IOException(where + "object id " + std::to_string(id) +
+                                             " is not a whole number in [1, 255]");
+                    appendPose(objects[static_cast<int>(id)], values[0],
+                               poseOf(values, 2, where), where);
+                  });
+  return objects;
 }
 
 std::string
@@ -92,9 +145,11 @@ formatTumLine(const StampedPose& pose)
 }
 
 void
-writeTrajectory(const std::string& path, const Trajectory& trajectory)
+writeTrajectory(const std::string& path,
+                const Trajectory& trajectory,
+                const std::string& pose_name)
 {
-  std::string text = "# timestamp tx ty tz qx qy qz qw (camera-to-world, metres)\n";
+  std::string text = "# timestamp tx ty tz qx qy qz qw (" + pose_name + ", metres)\n";
   for (const StampedPose& pose : trajectory)
     text += formatTumLine(pose) + '\n';
   replaceFile(path, text);

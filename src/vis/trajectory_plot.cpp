@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <dynvo/common/timestamps.h>
+#include <dynvo/vis/label_renderer.h>
 #include <dynvo/vis/trajectory_plot.h>
 
 #include "window_png_writer.h"
@@ -136,7 +137,8 @@ bool
 writeTrajectoryPlot(const Trajectory& estimate,
                     const Trajectory& groundtruth,
                     const std::string& out_png,
-                    const TrajectoryPlotOptions& options)
+                    const TrajectoryPlotOptions& options,
+                    const std::vector<std::pair<int, Trajectory>>& objects)
 {
   options.validate();
   if (estimate.empty()) {
@@ -203,7 +205,20 @@ writeTrajectoryPlot(const Trajectory& estimate,
              options.groundtruth_color);
   addCurve(path, est_xs, est_ys, "x (m)", vertical_name, "estimate",
            options.estimate_color);
-  fitAxes(path, {&gt_xs, &est_xs}, {&gt_ys, &est_ys}, "x (m)", vertical_name);
+  std::vector<const std::vector<double>*> all_xs{&gt_xs, &est_xs};
+  std::vector<const std::vector<double>*> all_ys{&gt_ys, &est_ys};
+  std::vector<std::vector<double>> object_xs(objects.size()), object_ys(objects.size());
+  std::size_t o = 0;
+  for (const auto& [id, object] : objects) {
+    planeCoordinates(object, options.plane, object_xs[o], object_ys[o]);
+    const std::string label = "object " + std::to_string(id);
+    addCurve(path, object_xs[o], object_ys[o], "x (m)", vertical_name, label.c_str(),
+             LabelRenderer::labelColor(static_cast<std::uint8_t>(id)));
+    all_xs.push_back(&object_xs[o]);
+    all_ys.push_back(&object_ys[o]);
+    ++o;
+  }
+  fitAxes(path, all_xs, all_ys, "x (m)", vertical_name);
 
   if (!error.empty()) {
     auto* over_time = vtkChartXY::SafeDownCast(charts->GetChart(vtkVector2i(1, 0)));

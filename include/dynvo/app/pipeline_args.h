@@ -26,7 +26,8 @@ enum class PipelineStages {
  *
  * Both: -config, -write_config, -threads, -cell_size, -window_size, -max_pyramid_level,
  * -fb_check, -v, -q. PipelineStages::all adds -seed, -no_tracking, -no_segmentation,
- * -refine, -max_frames and -objects. Each parameter flag sets a key of
+ * -refine, -max_frames and the shared outputs -objects, -objects_dir, -clouds_dir and
+ * -clouds_every (runOutputPathsFromArguments()). Each parameter flag sets a key of
  * pipelineConfigTable() (its help names the key) and defaults to that key's value in
  * PipelineOptions(), so a flag means the same in every app and in a -config file.
  */
@@ -63,13 +64,23 @@ DYNVO_EXPORTS bool writeConfigIfRequested(const Arguments& args,
 /// \throws UsageError when it is not a whole number >= 0
 DYNVO_EXPORTS std::size_t maxFramesFromArguments(const Arguments& args);
 
-/** \brief prepareOutputs() for a run over a recording: the inputs are the source's files
- * and the -config file.
+/** \brief prepareOutputs() for a run over a recording: the app's outputs plus the
+ * shared -objects, -objects_dir and -clouds_dir; the inputs are the source's files and
+ * the -config file.
  * \throws UsageError naming the flag, the path and the problem
  */
 DYNVO_EXPORTS void prepareRunOutputs(const Arguments& args,
                                      const FrameSource& source,
-                                     const std::vector<OutputPath>& outputs);
+                                     std::vector<OutputPath> outputs);
+
+/** \brief The outputs of a run: the app's trajectory and label folder ("" = none) plus
+ * the shared -objects, -objects_dir, -clouds_dir and -clouds_every N (default 1).
+ * \throws UsageError when -clouds_every is not a whole number >= 1 or is given without
+ *         -clouds_dir
+ */
+DYNVO_EXPORTS RunOutputPaths runOutputPathsFromArguments(const Arguments& args,
+                                                         const std::string& trajectory,
+                                                         const std::string& labels_dir);
 
 /// How a run of the whole pipeline ended.
 struct PipelineRunEnd {

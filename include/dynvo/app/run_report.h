@@ -1,8 +1,11 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// What an odometry run writes (trajectory, label images, object motions) and prints.
+// What an odometry run writes (trajectory, label images, labelled clouds, object
+// motions and trajectories) and prints.
 #pragma once
 
+#include <dynvo/app/object_trajectories.h>
 #include <dynvo/app/odometry_pipeline.h>
+#include <dynvo/io/frame.h>
 #include <dynvo/io/partial_file.h>
 #include <dynvo/io/trajectory_io.h>
 
@@ -14,31 +17,39 @@
 
 namespace dynvo::app {
 
-/** \brief The files of a run. Label images are written as frames arrive (each replaced
- * whole); the trajectory and the objects file are written beside their destination
- * ("<file>.partial") and moved into place by finish(), so an interrupted run leaves
- * earlier files untouched. finish() writes nothing when no frame was added, so a run that
- * fails on its first frame replaces nothing.
+/// Where a run writes ("" = not written).
+struct RunOutputPaths {
+  std::string trajectory;       ///< TUM trajectory of the camera
+  std::string labels_dir;       ///< "<stamp>.png" label image per frame
+  std::string objects;          ///< object-motion lines (formatObjectMotionLine())
+  std::string clouds_dir;       ///< "<stamp>.pcd" labelled cloud (writeLabelledCloud())
+  std::size_t clouds_every = 1; ///< clouds of frames 0, N, 2N, ... only (N >= 1)
+  std::string objects_dir; ///< object trajectories and summary (writeObjectsFolder())
+};
+
+/** \brief The files of a run. Label images and clouds are written as frames arrive
+ * (each replaced whole); the trajectory, the objects file and the objects folder are
+ * written by finish() (the objects file beside its destination, "<file>.partial", until
+ * then), so an interrupted run leaves earlier files untouched. finish() writes nothing
+ * when no frame was added, so a run that fails on its first frame replaces nothing.
  */
 class DYNVO_EXPORTS RunOutputs {
 public:
-  /** \param[in] trajectory_path TUM trajectory ("" = none)
-   * \param[in] labels_dir folder for "<stamp>.png" label images ("" = none); created if needed
-   * \param[in] objects_path object-motion lines ("" = none)
+  /** \param[in] paths what to write; folders are created if needed
    * \param[in] initial_groundtruth when set, poses start at its pose nearest the first frame
+   * \throws std::invalid_argument when paths.clouds_every is 0
    * \throws pcl::IOException when a folder or file cannot be created
    */
-  RunOutputs(const std::string& trajectory_path,
-             const std::string& labels_dir,
-             const std::string& objects_path,
-             const Trajectory* initial_groundtruth = nullptr);
+  explicit RunOutputs(const RunOutputPaths& paths,
+                      const Trajectory* initial_groundtruth = nullptr);
 
   /// Records one frame; a frame the pipeline could not process (FrameResult::error) gets a
-  /// trajectory line but no label image. \throws pcl::IOException when a file cannot be
-  /// written
-  void add(const FrameResult& result);
+  /// trajectory line but no label image, cloud or object pose. \throws pcl::IOException
+  /// when a file cannot be written
+  void add(const Frame& frame, const FrameResult& result);
 
-  /// Writes the trajectory and moves the objects file into place, when a frame was added.
+  /// Writes the trajectory and the objects folder and moves the objects file into
+  /// place, when a frame was added.
   /// \throws pcl::IOException when a file cannot be written
   void finish();
 
@@ -46,14 +57,13 @@ public:
   const Trajectory& trajectory() const { return trajectory_; }
 
 private:
-  std::string trajectory_path_;
-  std::string labels_dir_;
-  std::string objects_path_;
+  RunOutputPaths paths_;
   const Trajectory* initial_groundtruth_;
   Eigen::Isometry3d T_world_start_ = Eigen::Isometry3d::Identity();
   std::unique_ptr<PartialFile> objects_file_; ///< removes the partial file unless moved
   std::ofstream objects_;
   Trajectory trajectory_;
+  ObjectTrajectories object_trajectories_;
 };
 
 /// Progress bar on a terminal, per-frame timings, and the closing lines of a run.

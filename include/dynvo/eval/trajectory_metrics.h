@@ -45,6 +45,29 @@ DYNVO_EXPORTS RpeResult computeRpe(const Trajectory& groundtruth,
                                    const Trajectory& estimate,
                                    const RpeOptions& options = {});
 
+/** \brief Translational RPE of a tracked object's trajectory against the true object's.
+ *
+ * An estimated object frame and the true one differ by a fixed unknown offset, and the
+ * plain RPE of object poses is not invariant to it, so what is scored is the world path
+ * of one point of the object: the origin of the estimated object frame. Its estimated
+ * positions are p_k = T_truth_estimate * estimate[k] origin (in the truth's world); its
+ * true positions are q = truth(t) * b, with b = inv(truth(t_0)) * p_0 its coordinates
+ * in the true object frame at the estimate's first stamp t_0 (truth interpolated,
+ * interpolatePose()). computeRpe() of the two point paths then gives, per pair,
+ * |(p_j - p_i) - (q_j - q_i)| (metres per delta); the rotation fields are 0 (the
+ * object's rotation enters through q only).
+ * \param[in] truth true object-to-world poses
+ * \param[in] estimate estimated object-to-world poses (the estimate's world)
+ * \param[in] T_truth_estimate maps the estimate's world into the truth's
+ * \param[in] options pair spacing, as computeRpe()
+ * \throws std::invalid_argument as computeRpe(), or when truth has no pose within 0.1 s
+ *         of the estimate's first stamp
+ */
+DYNVO_EXPORTS RpeResult computeObjectRpe(const Trajectory& truth,
+                                         const Trajectory& estimate,
+                                         const Eigen::Isometry3d& T_truth_estimate,
+                                         const RpeOptions& options = {});
+
 /// Absolute trajectory error after rigid alignment.
 struct AteResult {
   double rmse = 0.0;     ///< RMSE of the aligned position differences (metres)

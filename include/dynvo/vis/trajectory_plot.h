@@ -8,6 +8,8 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace dynvo {
 
@@ -42,13 +44,18 @@ struct DYNVO_EXPORTS TrajectoryPlotOptions {
  * \param[in] groundtruth ground-truth poses; may be empty (then only the path chart is drawn)
  * \param[in] out_png destination file; its folder must exist
  * \param[in] options plane, size, association and colours
+ * \param[in] objects (label id, object-to-world trajectory) pairs in the
+ *            estimate's frame (dynvo_odometry -objects_dir): each is drawn in the path
+ *            chart in its label's colour (LabelRenderer::labelColor()); may be empty
  * \return true when the PNG was written; false (with a PCL_ERROR or, without a display, a
  *         PCL_WARN) otherwise
  * \throws std::invalid_argument when options.validate() fails
  */
-DYNVO_EXPORTS bool writeTrajectoryPlot(const Trajectory& estimate,
-                                       const Trajectory& groundtruth,
-                                       const std::string& out_png,
-                                       const TrajectoryPlotOptions& options = {});
+DYNVO_EXPORTS bool
+writeTrajectoryPlot(const Trajectory& estimate,
+                    const Trajectory& groundtruth,
+                    const std::string& out_png,
+                    const TrajectoryPlotOptions& options = {},
+                    const std::vector<std::pair<int, Trajectory>>& objects = {});
 
 } // namespace dynvo
