@@ -214,16 +214,18 @@ TEST(OdometryPipeline, ABadFrameLeavesTheRestOfTheRunUntouched)
 
 TEST(OdometryPipeline, InlierThresholdFollowsTheMeasuredNoise)
 {
-  // Synthetic Kinect noise after the depth window leaves a static-fit residual of about
-  // 2e-6 m^2; 3 x its running mean is below the lower bound, so the threshold starts at the
-  // upper bound (no residual measured yet) and settles on the paper's 3e-5.
+  // The threshold starts at the upper bound (no residual measured yet), then follows 3 x the
+  // running mean of the static fit's residual. Synthetic Kinect noise after the depth window,
+  // with the far background in the static set (the sensor model keeps it), leaves a residual
+  // of about 1.2e-5 m^2: the threshold settles near 3.6e-5, well below the 6e-5 upper bound
+  // and above the 3e-5 lower one.
   const dynvo::app::PipelineOptions defaults;
   const SequenceRun run = runScenario("moving_static", 20);
   EXPECT_DOUBLE_EQ(run.inlier_threshold[1], defaults.segmentation.inlier_threshold);
-  for (std::size_t k = 2; k < run.inlier_threshold.size(); ++k)
-    EXPECT_DOUBLE_EQ(run.inlier_threshold[k],
-                     defaults.inlier_noise.min_inlier_threshold)
-        << k;
+  for (std::size_t k = 2; k < run.inlier_threshold.size(); ++k) {
+    EXPECT_GE(run.inlier_threshold[k], defaults.inlier_noise.min_inlier_threshold) << k;
+    EXPECT_LT(run.inlier_threshold[k], 0.75 * defaults.segmentation.inlier_threshold) << k;
+  }
 }
 
 TEST(OdometryPipeline, InlierThresholdStaysLooseOnRealKinectFrames)

@@ -70,10 +70,12 @@ void
 BM_SpatialSegmentation(benchmark::State& state)
 {
   const std::vector<FlowFrame>& frames = sequence(state.range(0) == 1);
-  std::vector<dynvo::GridFlowData> grids(frames.size());
-  for (std::size_t k = 0; k < frames.size(); ++k)
-    grids[k].assign(*frames[k].flow, gridOf(frames[k]));
   const dynvo::RigidMotionSegmentationParameters params;
+  std::vector<dynvo::GridFlowData> grids(frames.size());
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    grids[k].assign(*frames[k].flow, gridOf(frames[k]));
+    grids[k].setSensorNoise(params.noise, 525.0f, 1.0f, 1.0f);
+  }
   dynvo::SpatialSegmenter segmenter;
   dynvo::SpatialSegmentationResult result;
   std::size_t k = 0;
@@ -131,6 +133,7 @@ BM_SegmentTracking(benchmark::State& state)
   dynvo::SpatialSegmenter segmenter;
   for (std::size_t k = 0; k < frames.size(); ++k) {
     grids[k].assign(*frames[k].flow, gridOf(frames[k]));
+    grids[k].setSensorNoise(params.noise, 525.0f, 1.0f, 1.0f);
     segmenter.segment(grids[k], params, spatial[k]);
   }
   dynvo::SegmentTracker tracker;

@@ -18,6 +18,7 @@ GridFlowData::assign(const pcl::PointCloud<PointFlow>& flow, const FlowGrid& gri
   previous_pixel.resize(n);
   a.resize(n);
   b.resize(n);
+  information.clear();
   for (std::size_t i = 0; i < n; ++i) {
     const PointFlow& f = flow[i];
     valid_2d[i] = f.valid_2d && std::isfinite(f.prev_u) && std::isfinite(f.prev_v);
@@ -29,6 +30,19 @@ GridFlowData::assign(const pcl::PointCloud<PointFlow>& flow, const FlowGrid& gri
     a[i] = Eigen::Vector3f(f.prev_x, f.prev_y, f.prev_z);
     b[i] = Eigen::Vector3f(f.x, f.y, f.z);
   }
+}
+
+void
+GridFlowData::setSensorNoise(const SensorNoiseModel& noise,
+                             float focal,
+                             float axial_gain,
+                             float lateral_gain)
+{
+  information.assign(size(), Eigen::Matrix3f::Zero());
+  for (std::size_t i = 0; i < size(); ++i)
+    if (valid_3d[i])
+      information[i] =
+          noise.transferInformation(a[i], b[i], focal, axial_gain, lateral_gain);
 }
 
 } // namespace dynvo

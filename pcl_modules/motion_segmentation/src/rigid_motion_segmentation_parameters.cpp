@@ -12,15 +12,29 @@ RigidMotionSegmentationParameters::table()
 {
   using P = RigidMotionSegmentationParameters;
   using R = FieldRange;
-  static_assert(AGGREGATE_FIELD_COUNT<P> == 23, "every field of P needs a row below");
-  static const ParameterTable<P> table(std::vector<ParameterTable<P>::Field>{
+  static_assert(AGGREGATE_FIELD_COUNT<P> == 30, "every field of P needs a row below");
+  using Fields = std::vector<ParameterTable<P>::Field>;
+  static const ParameterTable<P> table{Fields{
       makeField("max_hypotheses", &P::max_hypotheses, R::closed(1, 254), "h_max"),
       makeField("max_trials", &P::max_trials, R::atLeast(1),
                 "T_max, >= max_hypotheses"),
       makeField("sample_size", &P::sample_size, R::atLeast(3), "m, points"),
       makeField("search_radius", &P::search_radius, R::atLeast(1), "r_search, cells"),
+      makeChoiceField("residual_model", &P::residual_model, {"paper", "sensor"},
+                      "unit of E_i"),
       makeField("inlier_threshold", &P::inlier_threshold, R::above(0),
-                "th_inlier, m^2"),
+                "th_inlier, m^2, paper model"),
+      makeField("inlier_chi2", &P::inlier_chi2, R::above(0),
+                "th_chi2, sigma^2, sensor model"),
+      makeField("sensor_entropy_lambda", &P::sensor_entropy_lambda, R::above(0),
+                "lambda_chi2, sigma^-2"),
+      makeField("sensor_dbscan_epsilon", &P::sensor_dbscan_epsilon, R::above(0),
+                "eps_chi2, sigma")},
+      nestFields("noise", &P::noise, SensorNoiseModel::table().fields()),
+      Fields{
+      makeField("noise_scale_min", &P::noise_scale_min, R::above(0), "s_min"),
+      makeField("noise_scale_max", &P::noise_scale_max, R::above(0),
+                "s_max, >= s_min"),
       makeField("entropy_lambda", &P::entropy_lambda, R::above(0), "lambda, m^-2"),
       makeField("entropy_delta", &P::entropy_delta, R::above(0), "delta"),
       makeField("refine_iterations", &P::refine_iterations, R::atLeast(1),
@@ -44,8 +58,7 @@ RigidMotionSegmentationParameters::table()
                 "k_sep, 0 = off"),
       makeField("object_separation_hold", &P::object_separation_hold, R::atLeast(1),
                 "k_hold, <= k_sep"),
-      makeField("seed", &P::seed, R::closed(0, 4294967295.0), "sampling seed"),
-  });
+      makeField("seed", &P::seed, R::closed(0, 4294967295.0), "sampling seed")}};
   return table;
 }
 
@@ -58,6 +71,10 @@ RigidMotionSegmentationParameters::validate() const
     throw std::invalid_argument(prefix + " max_trials must be >= max_hypotheses (" +
                                 std::to_string(max_hypotheses) + "), got " +
                                 std::to_string(max_trials));
+  if (noise_scale_max < noise_scale_min)
+    throw std::invalid_argument(prefix + " noise_scale_max must be >= noise_scale_min (" +
+                                formatFieldValue(noise_scale_min, true) + "), got " +
+                                formatFieldValue(noise_scale_max, true));
   if (object_separation_ratio != 0.0f &&
       object_separation_hold > object_separation_ratio)
     throw std::invalid_argument(

@@ -161,20 +161,21 @@ SegmentTracker::freeId(const std::vector<int>& taken) const
 }
 
 std::vector<int>
-SegmentTracker::matchSegments(const SpatialSegmentationResult& spatial,
+SegmentTracker::matchSegments(const GridFlowData& grid,
+                              const SpatialSegmentationResult& spatial,
                               const RigidMotionSegmentationParameters& params) const
 {
   const int g = spatial.segmentCount();
   std::vector<int> ids(g + 1, 0);
-  const bool history = std::any_of(buffer_.begin(), buffer_.end(), [](const auto& map) {
-    return std::any_of(map.begin(), map.end(), [](std::uint8_t l) {
-      return l != 0;
-    });
-  });
-  if (!history) {
-    // First pair: the largest segment is the background, the others 2, 3, ... by size.
+  if (!hasHistory()) {
+    // First pair: the background is the largest segment (paper model) or the segment whose
+    // motion explains the most cells (sensor model: real backgrounds split into several
+    // segments under noise, and a textured object can be the largest single one); the
+    // others 2, 3, ... by size.
+    const int background = grid.information.empty() ? 1 : widestConsensus(grid, spatial);
+    int next = LABEL_STATIC + 1;
     for (int i = 1; i <= g; ++i)
-      ids[i] = i <= params.max_labels ? i : 0;
+      ids[i] = i == background ? LABEL_STATIC : (next <= params.max_labels ? next++ : 0);
     return ids;
   }
   // Correlation with every buffered frame; frames in order of score (ties: most recent).
@@ -218,6 +219,39 @@ SegmentTracker::matchSegments(const SpatialSegmentationResult& spatial,
   return ids;
 }
 
+bool
+SegmentTracker::hasHistory() const
+{
+  return std::any_of(buffer_.begin(), buffer_.end(), [](const auto& map) {
+    return std::any_of(map.begin(), map.end(), [](std::uint8_t l) {
+      return l != 0;
+    });
+  });
+}
+
+int
+SegmentTracker::widestConsensus(const GridFlowData& grid,
+                                const SpatialSegmentationResult& spatial) const
+{
+  // Threshold of the segmentation's own inliers: every cell a segment's motion explains.
+  const float limit = spatial.inlier_threshold;
+  int best = 0;
+  std::size_t best_count = 0;
+  for (int c = 1; c <= spatial.segmentCount(); ++c) {
+    const Eigen::Matrix4d& H = spatial.motions[c - 1];
+    const Eigen::Matrix3f R = H.topLeftCorner<3, 3>().cast<float>();
+    const Eigen::Vector3f t = H.topRightCorner<3, 1>().cast<float>();
+    std::size_t count = 0;
+    for (std::size_t i = 0; i < grid.size(); ++i)
+      count += grid.valid_3d[i] && grid.error(i, R, t) <= limit ? 1 : 0;
+    if (count > best_count) {
+      best = c;
+      best_count = count;
+    }
+  }
+  return best;
+}
+
 void
 SegmentTracker::guardBackground(const GridFlowData& grid,
                                 const SpatialSegmentationResult& spatial,
@@ -229,11 +263,20 @@ SegmentTracker::guardBackground(const GridFlowData& grid,
   if (g == 0)
     return;
   // r_pred(c): RMS residual of segment c under the constant-velocity prediction (metres).
+  // [D] Sensor model: RMS distance between where the segment's motion and the prediction
+  // move its points, so that depth noise (3 cm at 4 m) does not count as a departure.
+  const bool sensor = !grid.information.empty();
   std::vector<double> sum(g + 1, 0.0);
-  for (std::size_t i = 0; i < grid.size(); ++i)
-    if (spatial.labels[i] != 0)
-      sum[spatial.labels[i]] += squaredTransferError(T_pred, grid.a[i].cast<double>(),
-                                                     grid.b[i].cast<double>());
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    const int c = spatial.labels[i];
+    if (c == 0)
+      continue;
+    const Eigen::Vector3d a = grid.a[i].cast<double>();
+    const Eigen::Vector3d b =
+        sensor ? Eigen::Vector3d((spatial.motions[c - 1] * a.homogeneous()).head<3>())
+               : grid.b[i].cast<double>();
+    sum[c] += squaredTransferError(T_pred, a, b);
+  }
   int c1 = 0, best = 0;
   std::vector<double> r(g + 1, 0.0);
   for (int c = 1; c <= g; ++c) {
@@ -262,6 +305,30 @@ SegmentTracker::guardBackground(const GridFlowData& grid,
     PCL_DEBUG(
         "[dynvo::SegmentTracker::update] no segment agrees with H_pred; no label 1.\n");
   }
+}
+
+void
+SegmentTracker::mergeNoiseSplits(const GridFlowData& grid,
+                                 const SpatialSegmentationResult& spatial,
+                                 const RigidMotionSegmentationParameters& params,
+                                 std::vector<int>& ids) const
+{
+  const int g = spatial.segmentCount();
+  const auto background = std::find(ids.begin() + 1, ids.end(), LABEL_STATIC);
+  if (grid.information.empty() || background == ids.end())
+    return;
+  const Eigen::Matrix4d& H = spatial.motions[background - ids.begin() - 1];
+  const Eigen::Matrix3f R = H.topLeftCorner<3, 3>().cast<float>();
+  const Eigen::Vector3f t = H.topRightCorner<3, 1>().cast<float>();
+  std::vector<std::vector<float>> errors(g + 1);
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    const int c = spatial.labels[i];
+    if (c != 0 && ids[c] != LABEL_STATIC)
+      errors[c].push_back(grid.error(i, R, t));
+  }
+  for (int c = 1; c <= g; ++c)
+    if (!errors[c].empty() && median(errors[c]) <= 0.5f * params.inlier_chi2)
+      ids[c] = LABEL_STATIC;
 }
 
 void
@@ -434,8 +501,12 @@ SegmentTracker::update(const GridFlowData& grid,
     map = warpNearest(map, grid);
 
   // §4: persistent ids for this frame's segments.
-  std::vector<int> ids = matchSegments(spatial, params);
-  guardBackground(grid, spatial, T_pred, params, ids);
+  std::vector<int> ids = matchSegments(grid, spatial, params);
+  // [D] The guard needs a prediction: none exists for the first pair of a sequence (the
+  // pipeline's identity would hand label 1 to whatever moves least in the image).
+  if (grid.information.empty() || hasHistory())
+    guardBackground(grid, spatial, T_pred, params, ids);
+  mergeNoiseSplits(grid, spatial, params, ids);
   tracked_.resize(grid.size());
   for (std::size_t i = 0; i < grid.size(); ++i)
     tracked_[i] = static_cast<std::uint8_t>(ids[spatial.labels[i]]);

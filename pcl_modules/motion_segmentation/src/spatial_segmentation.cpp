@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <limits>
 #include <numeric>
+#include <stdexcept>
 
 namespace dynvo {
 
@@ -24,16 +25,6 @@ struct RigidF {
   {
   }
 };
-
-/// E_k = ||R a + t - b||^2 (m^2) in float, for the per-point loops (paper eq. 1).
-inline float
-rigidError(const Eigen::Matrix3f& R,
-           const Eigen::Vector3f& t,
-           const Eigen::Vector3f& a,
-           const Eigen::Vector3f& b)
-{
-  return (R * a + t - b).squaredNorm();
-}
 
 /// Least-squares fit (docs/algorithm.md §2) of b = H a on the listed points; false when degenerate.
 bool
@@ -100,10 +91,19 @@ dbscan(const std::vector<double>& distances, int count, double epsilon, int min_
   return cluster;
 }
 
+ResidualThresholds
+ResidualThresholds::of(const RigidMotionSegmentationParameters& params)
+{
+  if (params.residual_model == ResidualModel::paper)
+    return {params.inlier_threshold, params.entropy_lambda, params.dbscan_epsilon};
+  return {params.inlier_chi2, params.sensor_entropy_lambda, params.sensor_dbscan_epsilon};
+}
+
 double
 motionFieldDistance(const MotionHypothesis& x,
                     const MotionHypothesis& y,
-                    const std::vector<Eigen::Vector3f>& a)
+                    const std::vector<Eigen::Vector3f>& a,
+                    const std::vector<Eigen::Matrix3f>& information)
 {
   const Eigen::Matrix3d dR =
       x.T_curr_prev.topLeftCorner<3, 3>() - y.T_curr_prev.topLeftCorner<3, 3>();
@@ -112,7 +112,9 @@ motionFieldDistance(const MotionHypothesis& x,
   double sum = 0.0;
   std::size_t n = 0;
   const auto add = [&](int i) {
-    sum += (dR * a[i].cast<double>() + dt).squaredNorm();
+    const Eigen::Vector3d d = dR * a[i].cast<double>() + dt;
+    sum += information.empty() ? d.squaredNorm()
+                               : d.dot(information[i].cast<double>() * d);
     ++n;
   };
   // Merge of the two ascending inlier lists: every index of the union once.
@@ -131,6 +133,14 @@ motionFieldDistance(const MotionHypothesis& x,
   return n == 0 ? 0.0 : std::sqrt(sum / static_cast<double>(n));
 }
 
+float
+SpatialSegmenter::error(const Eigen::Matrix3f& R, const Eigen::Vector3f& t, int k) const
+{
+  // Paper eq. 1, E_k = ||R a + t - b||^2, or its Mahalanobis form e^T W_k e.
+  const Eigen::Vector3f e = R * a_[k] + t - b_[k];
+  return w_.empty() ? e.squaredNorm() : e.dot(w_[k] * e);
+}
+
 void
 SpatialSegmenter::evaluate(const Eigen::Matrix4d& H)
 {
@@ -138,7 +148,7 @@ SpatialSegmenter::evaluate(const Eigen::Matrix4d& H)
   const int n = static_cast<int>(a_.size());
   errors_.resize(a_.size());
   for (int k = 0; k < n; ++k)
-    errors_[k] = rigidError(m.R, m.t, a_[k], b_[k]);
+    errors_[k] = error(m.R, m.t, k);
 }
 
 bool
@@ -175,13 +185,13 @@ SpatialSegmenter::tryHypothesis(const RigidMotionSegmentationParameters& params,
     return false;
   const RigidF m(H);
   for (const int k : sample_)
-    if (rigidError(m.R, m.t, a_[k], b_[k]) > params.inlier_threshold)
+    if (error(m.R, m.t, k) > th_.inlier)
       return false;
   // §3.3 refinement: inliers of all points, refit, until the set stops changing.
   std::vector<int>& inliers = hypothesis.inliers;
   for (int round = 0; round < params.refine_iterations; ++round) {
     evaluate(H);
-    collectInliers(errors_, params.inlier_threshold, inliers_);
+    collectInliers(errors_, th_.inlier, inliers_);
     if (round > 0 && inliers_ == inliers)
       break;
     if (static_cast<int>(inliers_.size()) < params.sample_size)
@@ -191,12 +201,12 @@ SpatialSegmenter::tryHypothesis(const RigidMotionSegmentationParameters& params,
     inliers.swap(inliers_);
   }
   evaluate(H);
-  collectInliers(errors_, params.inlier_threshold, inliers);
+  collectInliers(errors_, th_.inlier, inliers);
   if (static_cast<int>(inliers.size()) < params.sample_size)
     return false;
   // [D] A refit that drifted off its own sample describes other points, not the sample's motion.
   for (const int k : sample_)
-    if (errors_[k] > params.inlier_threshold)
+    if (errors_[k] > th_.inlier)
       return false;
   hypothesis.T_curr_prev = H;
   return true;
@@ -210,11 +220,11 @@ SpatialSegmenter::clusterHypotheses(
   std::vector<double> distances(static_cast<std::size_t>(h) * h, 0.0);
   for (int i = 0; i < h; ++i)
     for (int j = i + 1; j < h; ++j) {
-      const double d = motionFieldDistance(accepted_[i], accepted_[j], a_);
+      const double d = motionFieldDistance(accepted_[i], accepted_[j], a_, w_);
       distances[static_cast<std::size_t>(i) * h + j] = d;
       distances[static_cast<std::size_t>(j) * h + i] = d;
     }
-  return dbscan(distances, h, params.dbscan_epsilon, params.dbscan_min_points);
+  return dbscan(distances, h, th_.epsilon, params.dbscan_min_points);
 }
 
 void
@@ -251,20 +261,20 @@ SpatialSegmenter::label(const std::vector<int>& clusters,
   for (int k = 0; k < count; ++k) {
     float best = std::numeric_limits<float>::infinity();
     for (std::size_t c = 0; c < rigid.size(); ++c) {
-      const float e = rigidError(rigid[c].R, rigid[c].t, a_[k], b_[k]);
+      const float e = error(rigid[c].R, rigid[c].t, k);
       if (e < best) {
         best = e;
         assigned[k] = static_cast<int>(c);
       }
     }
-    if (!(best <= params.inlier_threshold))
+    if (!(best <= th_.inlier))
       assigned[k] = -1;
   }
-  // 3. Dissolve small segments, renumber by size (largest first), refit on final points.
   std::vector<int> sizes(motions.size(), 0);
   for (const int c : assigned)
     if (c >= 0)
       ++sizes[c];
+  // 3. Dissolve small segments, renumber by size (largest first), refit on final points.
   std::vector<int> order;
   for (std::size_t c = 0; c < motions.size(); ++c)
     if (sizes[c] >= params.min_segment_size)
@@ -296,6 +306,13 @@ SpatialSegmenter::segment(const GridFlowData& grid,
                           const RigidMotionSegmentationParameters& params,
                           SpatialSegmentationResult& result)
 {
+  th_ = ResidualThresholds::of(params);
+  result.inlier_threshold = th_.inlier;
+  if ((params.residual_model == ResidualModel::sensor) !=
+      (grid.information.size() == grid.size()))
+    throw std::invalid_argument(
+        "[dynvo::SpatialSegmenter::segment] the sensor model needs the grid's "
+        "information matrices (GridFlowData::setSensorNoise), the paper model none");
   result.labels.assign(grid.size(), 0);
   result.motions.clear();
   result.sizes.clear();
@@ -307,12 +324,15 @@ SpatialSegmenter::segment(const GridFlowData& grid,
   cell_of_packed_.clear();
   a_.clear();
   b_.clear();
+  w_.clear();
   for (std::size_t i = 0; i < grid.size(); ++i)
     if (grid.valid_3d[i]) {
       packed_of_cell_[i] = static_cast<int>(cell_of_packed_.size());
       cell_of_packed_.push_back(static_cast<int>(i));
       a_.push_back(grid.a[i]);
       b_.push_back(grid.b[i]);
+      if (!grid.information.empty())
+        w_.push_back(grid.information[i]);
     }
   const std::size_t n = a_.size();
   if (static_cast<int>(n) < 2 * params.sample_size)
@@ -337,7 +357,7 @@ SpatialSegmenter::segment(const GridFlowData& grid,
       min_errors_[k] = std::min(min_errors_[k], errors_[k]);
       entropy_[k] =
           1.0 - std::exp(-static_cast<double>(params.entropy_delta) -
-                         static_cast<double>(params.entropy_lambda) * min_errors_[k]);
+                         static_cast<double>(th_.lambda) * min_errors_[k]);
       sum += entropy_[k];
     }
     accepted_.push_back(hypothesis);

@@ -5,6 +5,7 @@
 #include <dynvo/common/export.h>
 #include <dynvo/common/flow_grid.h>
 #include <dynvo/common/point_types.h>
+#include <dynvo/common/sensor_noise_model.h>
 
 #include <pcl/point_cloud.h>
 
@@ -31,6 +32,9 @@ struct DYNVO_EXPORTS GridFlowData {
       a; ///< a_i (metres, previous camera frame); NaN when missing
   std::vector<Eigen::Vector3f>
       b; ///< b_i (metres, current camera frame); NaN when no depth at c_i
+  /// W_i, information matrix of the transfer error (sensor model: E_i = e^T W_i e, in
+  /// sigma^2); empty for the paper model (W_i = I, E_i in m^2)
+  std::vector<Eigen::Matrix3f> information;
 
   /// Number of cells.
   std::size_t size() const { return valid_3d.size(); }
@@ -52,6 +56,23 @@ struct DYNVO_EXPORTS GridFlowData {
    * \param[in] grid its geometry (FlowGrid::fromFlow()); only the geometry is kept
    */
   void assign(const pcl::PointCloud<PointFlow>& flow, const FlowGrid& grid);
+
+  /// E_i of cell i under the motion (R, t) mapping a_i to b_i: ||R a_i + t - b_i||^2, or
+  /// e^T W_i e with the information matrices (docs/algorithm.md §2).
+  float error(std::size_t i, const Eigen::Matrix3f& R, const Eigen::Vector3f& t) const
+  {
+    const Eigen::Vector3f e = R * a[i] + t - b[i];
+    return information.empty() ? e.squaredNorm() : e.dot(information[i] * e);
+  }
+
+  /** \brief Fills information for the sensor model: per cell
+   * noise.transferInformation(a_i, b_i, focal, axial_gain, lateral_gain), zero for cells
+   * without valid_3d.
+   */
+  void setSensorNoise(const SensorNoiseModel& noise,
+                      float focal,
+                      float axial_gain,
+                      float lateral_gain);
 };
 
 } // namespace dynvo

@@ -18,6 +18,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -110,6 +111,9 @@ public:
   /// The tracker state (tracked labels Ghat, model labels L, docs/algorithm.md §4-§6).
   const SegmentTracker& getTracker() const { return tracker_; }
 
+  /// The sensor model's gains {axial, lateral} for the next segment() (1 after reset()).
+  const std::array<float, 2>& getNoiseGains() const { return noise_gains_; }
+
   /** \brief Forgets the sequence (label buffer and models): the next segment() starts a new
    * one. Parameter setters keep the sequence; a new grid size or max_labels restarts it.
    */
@@ -150,7 +154,13 @@ public:
   DYNVO_PARAMETER_ACCESSORS(MaxTrials, max_trials)
   DYNVO_PARAMETER_ACCESSORS(SampleSize, sample_size)
   DYNVO_PARAMETER_ACCESSORS(SearchRadius, search_radius)
+  DYNVO_PARAMETER_ACCESSORS(ResidualModel, residual_model)
   DYNVO_PARAMETER_ACCESSORS(InlierThreshold, inlier_threshold)
+  DYNVO_PARAMETER_ACCESSORS(InlierChi2, inlier_chi2)
+  DYNVO_PARAMETER_ACCESSORS(SensorEntropyLambda, sensor_entropy_lambda)
+  DYNVO_PARAMETER_ACCESSORS(SensorDbscanEpsilon, sensor_dbscan_epsilon)
+  DYNVO_PARAMETER_ACCESSORS(NoiseScaleMin, noise_scale_min)
+  DYNVO_PARAMETER_ACCESSORS(NoiseScaleMax, noise_scale_max)
   DYNVO_PARAMETER_ACCESSORS(EntropyLambda, entropy_lambda)
   DYNVO_PARAMETER_ACCESSORS(EntropyDelta, entropy_delta)
   DYNVO_PARAMETER_ACCESSORS(RefineIterations, refine_iterations)
@@ -191,6 +201,15 @@ private:
   /// Clears every output of segment().
   void clearOutputs();
 
+  /// The grid's information matrices for the sensor model, with noise_gains_.
+  void computeInformation();
+
+  /// Fits noise_gains_ to the static cells' residuals under the background motion.
+  void updateNoiseScale();
+
+  /// Mean of fx and fy (px).
+  float focalLength() const;
+
   std::string class_name_ = "RigidMotionSegmentation"; ///< log prefix
   Parameters params_;                                  ///< validated knobs
   CameraIntrinsics intrinsics_; ///< current-frame intrinsics (default preset)
@@ -205,6 +224,9 @@ private:
   FlowGrid cell_grid_;                       ///< geometry and output label per cell
   std::vector<std::uint8_t> segment_labels_; ///< id of each output segment
   Motions motions_;                          ///< T_curr_prev of each output segment
+  /// s_axial, s_lateral: the sensor model's gains on its axial and lateral sigma, fitted
+  /// over the frames
+  std::array<float, 2> noise_gains_{1.0f, 1.0f};
 };
 
 } // namespace dynvo

@@ -5,10 +5,17 @@
 
 #include <dynvo/common/export.h>
 #include <dynvo/common/parameter_table.h>
+#include <dynvo/common/sensor_noise_model.h>
 
 #include <cstdint>
 
 namespace dynvo {
+
+/// How the transfer error E_i of a cell under a motion is measured (docs/algorithm.md §2).
+enum class ResidualModel {
+  paper, ///< E_i = ||R a_i + t - b_i||^2 (m^2), the paper's fixed metric tests
+  sensor ///< E_i = e^T (Sigma(a_i) + Sigma(b_i))^-1 e (gains applied): in sigma^2
+};
 
 /** \brief Parameters of RigidMotionSegmentation (the single source of the defaults).
  *
@@ -27,9 +34,30 @@ struct DYNVO_EXPORTS RigidMotionSegmentationParameters {
   /// at 3 m) nearly always holds boundary cells with mixed flow, so its 7-point samples fail.
   /// Measured on static_two (VGA, 40 frames): moving-object cell IoU 0.62 with 2, 0.81 with 1.
   int search_radius = 1;
-  /// th_inlier (m^2, > 0): E_i <= th_inlier is an inlier (5.5 mm); dynvo::app::PipelineOptions
-  /// raises it to 6e-5 for real Kinect noise
+  /// Unit of E_i: the paper's squared metres or the noise-normalised Mahalanobis distance.
+  ResidualModel residual_model = ResidualModel::sensor;
+  /// th_inlier (m^2, > 0), paper model: E_i <= th_inlier is an inlier (5.5 mm);
+  /// dynvo::app::PipelineOptions raises it to 6e-5 for real Kinect noise
   float inlier_threshold = 3e-5f;
+  /// th_chi2 (sigma^2, > 0), sensor model: E_i <= th_chi2 is an inlier (16: 0.1 % of
+  /// static cells fail, chi-square with 3 degrees of freedom)
+  float inlier_chi2 = 16.0f;
+  /// lambda_chi2 (sigma^-2, > 0), sensor model: entropy shape. The paper's lambda times
+  /// th_inlier / th_chi2, so the entropy at the inlier radius is the paper's.
+  float sensor_entropy_lambda = 1.875e-3f;
+  /// eps_chi2 (sigma, > 0), sensor model: DBSCAN radius. The paper's eps times
+  /// sqrt(th_chi2 / th_inlier): the same ratio to the inlier radius.
+  float sensor_dbscan_epsilon = 3.65f;
+  /// Shape of the per-point covariance Sigma (sensor model).
+  SensorNoiseModel noise;
+  /// s_min (> 0): smallest noise gain. Two gains (axial, lateral) multiply the sensor
+  /// model's sigmas and are fitted to the residuals near the background's motion every
+  /// frame (docs/algorithm.md §3.0). 0.2: 0.12 px across the ray, well below real tracking
+  /// (0.3-0.8 px on TUM fr1/xyz) and above the synthetic scenes' 0.03 px, which would let
+  /// every 7-point hypothesis explain only its own neighbourhood.
+  float noise_scale_min = 0.2f;
+  /// s_max (>= s_min): largest noise gain
+  float noise_scale_max = 4.0f;
   /// lambda (m^-2, > 0): entropy shape, S = 1 - exp(-delta - lambda E)
   float entropy_lambda = 1e3f;
   /// delta (> 0): entropy floor

@@ -90,8 +90,16 @@ private:
                                         const GridFlowData& grid) const;
 
   /// §4: tracked id of each segment (index 1..g; 0 = none).
-  std::vector<int> matchSegments(const SpatialSegmentationResult& spatial,
+  std::vector<int> matchSegments(const GridFlowData& grid,
+                                 const SpatialSegmentationResult& spatial,
                                  const RigidMotionSegmentationParameters& params) const;
+
+  /// True when a buffered label map holds a label (not the first pair of a sequence).
+  bool hasHistory() const;
+
+  /// Segment (1..g) whose motion has the most valid cells within the inlier threshold.
+  int widestConsensus(const GridFlowData& grid,
+                      const SpatialSegmentationResult& spatial) const;
 
   /// §4 static-background guard on the segment ids.
   void guardBackground(const GridFlowData& grid,
@@ -99,6 +107,16 @@ private:
                        const Eigen::Matrix4d& T_pred,
                        const RigidMotionSegmentationParameters& params,
                        std::vector<int>& ids) const;
+
+  /** \brief [D] Sensor model: a segment whose typical cell the background's motion explains
+   * (median E_i under the label-1 segment's motion <= th_chi2 / 2, 2.8 sigma) is the
+   * background split by noise (near and far parts, colour and depth not taken at one
+   * instant); it takes label 1. Paper model: no change.
+   */
+  void mergeNoiseSplits(const GridFlowData& grid,
+                        const SpatialSegmentationResult& spatial,
+                        const RigidMotionSegmentationParameters& params,
+                        std::vector<int>& ids) const;
 
   /// Marks the ids held by a buffered map or as argmax of an initialised model (used_).
   void collectUsedIds(int labels);

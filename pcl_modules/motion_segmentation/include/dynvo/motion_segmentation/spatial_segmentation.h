@@ -30,6 +30,7 @@ struct SpatialSegmentationResult {
   std::vector<MotionHypothesis>
       hypotheses; ///< accepted hypotheses, inliers as cell indices
   int trials = 0; ///< trials made, failed ones included
+  float inlier_threshold = 0.0f; ///< th of this result, in the unit of E_i
 
   /// Number of segments g.
   int segmentCount() const { return static_cast<int>(sizes.size()); }
@@ -49,14 +50,27 @@ struct SpatialSegmentationResult {
 DYNVO_EXPORTS std::vector<int>
 dbscan(const std::vector<double>& distances, int count, double epsilon, int min_points);
 
-/** \brief Motion-field distance of two hypotheses (metres, docs/algorithm.md §3.5):
- * sqrt(mean over i in I_x u I_y of ||(R_x - R_y) a_i + (t_x - t_y)||^2); 0 when both
- * are empty.
+/** \brief Motion-field distance of two hypotheses (docs/algorithm.md §3.5):
+ * sqrt(mean over i in I_x u I_y of d_i^T W_i d_i), d_i = (R_x - R_y) a_i + (t_x - t_y);
+ * 0 when both are empty.
  * \param[in] a points the inlier indices refer to (metres, previous camera frame)
+ * \param[in] information W_i per point (the sensor model's, in 1 / sigma^2: the distance
+ *            is in sigma), or empty for W_i = I (the paper's distance in metres)
  */
 DYNVO_EXPORTS double motionFieldDistance(const MotionHypothesis& x,
                                          const MotionHypothesis& y,
-                                         const std::vector<Eigen::Vector3f>& a);
+                                         const std::vector<Eigen::Vector3f>& a,
+                                         const std::vector<Eigen::Matrix3f>& information);
+
+/// The three thresholds of the search in the unit of E_i (docs/algorithm.md §2).
+struct DYNVO_EXPORTS ResidualThresholds {
+  float inlier = 0.0f;  ///< th: E_i <= th is an inlier
+  float lambda = 0.0f;  ///< entropy shape, per unit of E_i
+  float epsilon = 0.0f; ///< DBSCAN radius, in the unit of sqrt(E_i)
+
+  /// The paper model's th_inlier, lambda, eps (m^2, m^-2, m) or the sensor model's.
+  static ResidualThresholds of(const RigidMotionSegmentationParameters& params);
+};
 
 /** \brief The two-frame segmentation of docs/algorithm.md §3 on the valid_3d cells of a grid.
  *
@@ -71,7 +85,7 @@ DYNVO_EXPORTS double motionFieldDistance(const MotionHypothesis& x,
  */
 class DYNVO_EXPORTS SpatialSegmenter {
 public:
-  /** \param[in] grid scene flow of the frame pair
+  /** \param[in] grid scene flow of the frame pair, with information for the sensor model
    *  \param[in] params validated parameters
    *  \param[out] result labels per cell and one motion per segment (all 0 and no segment
    *              when fewer than 2 m cells are valid_3d)
@@ -81,6 +95,9 @@ public:
                SpatialSegmentationResult& result);
 
 private:
+  /// E_k of packed point k under a motion (R, t).
+  float error(const Eigen::Matrix3f& R, const Eigen::Vector3f& t, int k) const;
+
   /// Fills errors_ with E_k(H) for every packed point.
   void evaluate(const Eigen::Matrix4d& H);
 
@@ -103,6 +120,8 @@ private:
   std::vector<int> cell_of_packed_; ///< cell index of each packed point
   std::vector<Eigen::Vector3f> a_;  ///< packed a_i
   std::vector<Eigen::Vector3f> b_;  ///< packed b_i
+  std::vector<Eigen::Matrix3f> w_;  ///< packed W_i, empty for the paper model
+  ResidualThresholds th_;           ///< thresholds of this call
   std::vector<float> errors_;       ///< E_k of the hypothesis being evaluated
   std::vector<float> min_errors_;   ///< min over accepted hypotheses of E_k
   std::vector<double> entropy_;     ///< S_k

@@ -35,6 +35,7 @@ RigidMotionSegmentation<PointT>::reset()
 {
   clearOutputs();
   tracker_.reset();
+  noise_gains_ = {1.0f, 1.0f};
 }
 
 template <typename PointT>
@@ -198,6 +199,7 @@ RigidMotionSegmentation<PointT>::segment(std::vector<pcl::PointIndices>& segment
   if (!validateInputs())
     return;
   grid_.assign(*flow_, cell_grid_);
+  computeInformation();
   segmenter_.segment(grid_, params_, spatial_);
   PCL_DEBUG("[dynvo::%s::segment] %d segments from %zu hypotheses (%d trials).\n",
             getClassName().c_str(), spatial_.segmentCount(), spatial_.hypotheses.size(),
@@ -221,7 +223,74 @@ RigidMotionSegmentation<PointT>::segment(std::vector<pcl::PointIndices>& segment
       motions_.push_back(spatial_.motions[c - 1].cast<float>());
     }
   }
+  updateNoiseScale();
   computeImplIndices(segments);
+}
+
+template <typename PointT>
+void
+RigidMotionSegmentation<PointT>::computeInformation()
+{
+  if (params_.residual_model != ResidualModel::sensor)
+    return;
+  for (float& gain : noise_gains_)
+    gain = std::clamp(gain, params_.noise_scale_min, params_.noise_scale_max);
+  grid_.setSensorNoise(params_.noise, focalLength(), noise_gains_[0], noise_gains_[1]);
+}
+
+template <typename PointT>
+void
+RigidMotionSegmentation<PointT>::updateNoiseScale()
+{
+  if (grid_.information.empty() || motions_.empty())
+    return;
+  // On static cells, the axial part of the transfer error over its model variance is
+  // chi-square with 1 degree of freedom (median 0.455), the lateral part with 2 (median
+  // 1.386), when the model's shape holds; each gain is the root of the observed median
+  // over that. The cells are every valid cell within 4 th_chi2 (about 8 sigma) of the
+  // background's motion, not only label 1: when noise splits the background, label 1 is
+  // the part that fits best, and its residuals alone would shrink the gains frame by frame.
+  constexpr float MEDIAN[2] = {0.455f, 1.386f};
+  constexpr std::size_t MIN_CELLS = 30;
+  const float focal = focalLength();
+  const Eigen::Matrix3f R = motions_[0].topLeftCorner<3, 3>();
+  const Eigen::Vector3f t = motions_[0].topRightCorner<3, 1>();
+  std::array<std::vector<float>, 2> ratios;
+  for (std::size_t i = 0; i < grid_.size(); ++i)
+    if (grid_.valid_3d[i] && grid_.error(i, R, t) <= 4.0f * params_.inlier_chi2) {
+      const Eigen::Vector3f& a = grid_.a[i];
+      const Eigen::Vector3f& b = grid_.b[i];
+      const Eigen::Vector3f e = R * a + t - b;
+      const float axial = e.dot(b.normalized());
+      const SensorNoiseModel& noise = params_.noise;
+      const float axial_variance = noise.axialSigma(a.z()) * noise.axialSigma(a.z()) +
+                                   noise.axialSigma(b.z()) * noise.axialSigma(b.z());
+      const float lateral_variance =
+          noise.lateralSigma(a.z(), focal) * noise.lateralSigma(a.z(), focal) +
+          noise.lateralSigma(b.z(), focal) * noise.lateralSigma(b.z(), focal);
+      ratios[0].push_back(axial * axial / axial_variance);
+      ratios[1].push_back((e.squaredNorm() - axial * axial) / lateral_variance);
+    }
+  if (ratios[0].size() < MIN_CELLS)
+    return;
+  for (int k = 0; k < 2; ++k) {
+    std::vector<float>& r = ratios[k];
+    const auto middle = r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2);
+    std::nth_element(r.begin(), middle, r.end());
+    // Geometric mean with the previous gain: the fit of one frame moves it half way.
+    const float fitted = std::sqrt(*middle / MEDIAN[k]);
+    noise_gains_[k] = std::clamp(std::sqrt(noise_gains_[k] * fitted),
+                                 params_.noise_scale_min, params_.noise_scale_max);
+  }
+  PCL_DEBUG("[dynvo::%s::segment] noise gains: axial %.3f, lateral %.3f (%zu cells).\n",
+            getClassName().c_str(), noise_gains_[0], noise_gains_[1], ratios[0].size());
+}
+
+template <typename PointT>
+float
+RigidMotionSegmentation<PointT>::focalLength() const
+{
+  return static_cast<float>(0.5 * (intrinsics_.fx + intrinsics_.fy));
 }
 
 } // namespace dynvo
