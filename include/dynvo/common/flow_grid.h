@@ -4,6 +4,7 @@
 #pragma once
 
 #include <dynvo/common/conventions.h>
+#include <dynvo/common/export.h>
 #include <dynvo/common/point_types.h>
 
 #include <pcl/point_cloud.h>
@@ -34,7 +35,7 @@ namespace dynvo {
  *   grid.labels[i] = dynvo::LABEL_STATIC;  // e.g. select cell i
  * \endcode
  */
-struct FlowGrid {
+struct DYNVO_EXPORTS FlowGrid {
   std::uint32_t image_width = 0;    ///< columns of the image the grid covers (px)
   std::uint32_t image_height = 0;   ///< rows of the image the grid covers (px)
   std::uint32_t cell_size = 0;      ///< w_grid (px); 0 for an empty grid
