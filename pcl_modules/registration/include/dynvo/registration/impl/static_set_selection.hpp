@@ -3,7 +3,6 @@
 #pragma once
 
 #include <dynvo/common/rigid_fit.h>
-#include <dynvo/registration/impl/static_scene_registration.hpp>
 #include <dynvo/registration/static_set_selection.h>
 
 namespace dynvo {
