@@ -32,12 +32,9 @@ SensorNoiseModel::transferInformation(const Eigen::Vector3f& a,
                                       float axial_gain,
                                       float lateral_gain) const
 {
-  const float axial_a = axialSigma(a.z()), axial_b = axialSigma(b.z());
-  const float lateral_a = lateralSigma(a.z(), focal),
-              lateral_b = lateralSigma(b.z(), focal);
-  const float axial = axial_gain * axial_gain * (axial_a * axial_a + axial_b * axial_b);
-  const float lateral =
-      lateral_gain * lateral_gain * (lateral_a * lateral_a + lateral_b * lateral_b);
+  const TransferVariance variance = transferVariance(a, b, focal);
+  const float axial = axial_gain * axial_gain * variance.axial;
+  const float lateral = lateral_gain * lateral_gain * variance.lateral;
   const Eigen::Vector3f ray = b.normalized();
   const Eigen::Matrix3f along = ray * ray.transpose();
   return along / axial + (Eigen::Matrix3f::Identity() - along) / lateral;

@@ -45,6 +45,21 @@ struct DYNVO_EXPORTS SensorNoiseModel {
   /// Lateral sigma at depth z (metres) for focal length focal (px).
   float lateralSigma(float z, float focal) const { return z * lateral_pixels / focal; }
 
+  /// Axial and lateral variances (m^2) of the transfer error between a and b: the sums of
+  /// both points' sigma^2 (see transferInformation()).
+  struct TransferVariance {
+    float axial;
+    float lateral;
+  };
+  TransferVariance transferVariance(const Eigen::Vector3f& a,
+                                    const Eigen::Vector3f& b,
+                                    float focal) const
+  {
+    const float axial_a = axialSigma(a.z()), axial_b = axialSigma(b.z());
+    const float lateral_a = lateralSigma(a.z(), focal), lateral_b = lateralSigma(b.z(), focal);
+    return {axial_a * axial_a + axial_b * axial_b, lateral_a * lateral_a + lateral_b * lateral_b};
+  }
+
   /** \brief Information matrix of the transfer error between two measurements a and b
    * (metres) of one point taken with focal length focal (px): the inverse of
    * Sigma(a) + Sigma(b) with both rays taken along b's, and the axial and lateral

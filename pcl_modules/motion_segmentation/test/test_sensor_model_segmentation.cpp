@@ -110,6 +110,14 @@ TEST(SensorNoiseModel, InformationWeighsTheRayAndItsSidesByTheirSigma)
   const Eigen::Matrix3f W2 = model.transferInformation(p, p, focal, 2.0f, 1.0f);
   EXPECT_NEAR(W2(2, 2), 0.25f * W(2, 2), 1e-3f * W(2, 2));
   EXPECT_NEAR(W2(0, 0), W(0, 0), 1e-3f * W(0, 0));
+  // Two independent measurements at 1 m and 3 m: their variances add, and the information
+  // along the ray is the inverse of that sum.
+  const Eigen::Vector3f near(0.0f, 0.0f, 1.0f);
+  const dynvo::SensorNoiseModel::TransferVariance v = model.transferVariance(near, p, focal);
+  const float s1 = model.axialSigma(1.0f), s3 = model.axialSigma(3.0f);
+  EXPECT_NEAR(v.axial, s1 * s1 + s3 * s3, 1e-4f * v.axial);
+  EXPECT_NEAR(model.transferInformation(near, p, focal)(2, 2), 1.0f / v.axial,
+              1e-4f / v.axial);
 }
 
 TEST(SensorModelSegmentation, FarWallStaysOneStaticSegment)

@@ -262,14 +262,10 @@ RigidMotionSegmentation<PointT>::updateNoiseScale()
       const Eigen::Vector3f& b = grid_.b[i];
       const Eigen::Vector3f e = R * a + t - b;
       const float axial = e.dot(b.normalized());
-      const SensorNoiseModel& noise = params_.noise;
-      const float axial_variance = noise.axialSigma(a.z()) * noise.axialSigma(a.z()) +
-                                   noise.axialSigma(b.z()) * noise.axialSigma(b.z());
-      const float lateral_variance =
-          noise.lateralSigma(a.z(), focal) * noise.lateralSigma(a.z(), focal) +
-          noise.lateralSigma(b.z(), focal) * noise.lateralSigma(b.z(), focal);
-      ratios[0].push_back(axial * axial / axial_variance);
-      ratios[1].push_back((e.squaredNorm() - axial * axial) / lateral_variance);
+      const SensorNoiseModel::TransferVariance variance =
+          params_.noise.transferVariance(a, b, focal);
+      ratios[0].push_back(axial * axial / variance.axial);
+      ratios[1].push_back((e.squaredNorm() - axial * axial) / variance.lateral);
     }
   if (ratios[0].size() < MIN_CELLS)
     return;
