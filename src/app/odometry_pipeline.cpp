@@ -10,6 +10,7 @@
 
 #include <pcl/console/print.h>
 
+#include <Eigen/Geometry>
 #include <Eigen/SVD>
 
 #include <chrono>
@@ -79,6 +80,7 @@ struct OdometryPipeline::Impl {
     segmentation.setParameters(options.segmentation);
     segmentation.setNumberOfThreads(options.threads);
     registration.setParameters(options.registration);
+    keyframe_registration.setParameters(options.registration);
     selection.setParameters(options.static_set);
     selection.setMotionGuardTolerance(options.segmentation.static_guard_tolerance);
     noise_tracker.setParameters(options.inlier_noise);
@@ -140,10 +142,87 @@ struct OdometryPipeline::Impl {
     result.times.registration_ms = millisecondsSince(registration_start);
   }
 
+  /** Registers the frame's static cells against the keyframe and takes a new keyframe when
+   * needed (docs/algorithm.md §7.3); sets result.T_world_curr, and result.lost to false when
+   * the keyframe fit passes although the frame-to-frame one did not.
+   */
+  void trackKeyframe(const Cloud::ConstPtr& cloud)
+  {
+    if (keyframe_is_previous) {
+      // The frame-to-frame fit is the first fit to the keyframe: its reference inliers.
+      keyframe_is_previous = false;
+      keyframe_inliers = result.lost ? 0 : registration.getNumberOfInliers();
+      result.keyframe_overlap = result.lost ? 0.0 : 1.0;
+    }
+    else if (flow_estimation.getKeyframeCloud()) {
+      registerToKeyframe(cloud);
+    }
+    const Eigen::Matrix4d T_keyframe_curr =
+        rigidInverse(T_world_keyframe) * result.T_world_curr;
+    const double angle =
+        Eigen::AngleAxisd(Eigen::Matrix3d(T_keyframe_curr.topLeftCorner<3, 3>()))
+            .angle();
+    const bool renew =
+        !flow_estimation.getKeyframeCloud() ||
+        result.keyframe_overlap < options.keyframe_min_overlap ||
+        T_keyframe_curr.topRightCorner<3, 1>().norm() > options.keyframe_max_distance ||
+        angle > options.keyframe_max_angle;
+    // A lost frame never becomes the keyframe: the next frames are tracked against the last
+    // good one.
+    PCL_DEBUG(
+        "[dynvo::app::OdometryPipeline] frame %zu: keyframe overlap %.2f, %.3f m, "
+        "%.3f rad from it%s\n",
+        frames, result.keyframe_overlap, T_keyframe_curr.topRightCorner<3, 1>().norm(),
+        angle, renew ? ", new keyframe" : "");
+    if (renew && !result.lost && flow_estimation.setCurrentAsKeyframe()) {
+      T_world_keyframe = result.T_world_curr;
+      keyframe_is_previous = true;
+      result.keyframe = true;
+    }
+  }
+
+  /// The fit to the keyframe, seeded with the frame-to-frame estimate (or the prediction).
+  void registerToKeyframe(const Cloud::ConstPtr& cloud)
+  {
+    const auto flow_start = Clock::now();
+    const Eigen::Matrix4d T_keyframe_guess =
+        rigidInverse(T_world_keyframe) * result.T_world_curr;
+    // Without a frame-to-frame estimate the guess is the constant-velocity prediction: the
+    // whole pyramid is searched around it.
+    const int levels = result.lost ? options.scene_flow.max_pyramid_level : 0;
+    flow_estimation.computeToKeyframe(T_keyframe_guess.cast<float>(), levels,
+                                      *keyframe_flow);
+    result.times.scene_flow_ms += millisecondsSince(flow_start);
+
+    const auto registration_start = Clock::now();
+    keyframe_registration.setInputSource(cloud);
+    keyframe_registration.setInputTarget(flow_estimation.getKeyframeCloud());
+    keyframe_registration.setInputFlow(keyframe_flow);
+    selection.setPredictedMotion(rigidInverse(T_keyframe_guess));
+    if (selection.align(keyframe_registration)) {
+      result.T_world_curr =
+          T_world_keyframe *
+          keyframe_registration.getFinalTransformation().cast<double>();
+      result.lost = false;
+      result.keyframe_overlap =
+          keyframe_inliers == 0
+              ? 0.0
+              : static_cast<double>(keyframe_registration.getNumberOfInliers()) /
+                    static_cast<double>(keyframe_inliers);
+    }
+    result.times.registration_ms += millisecondsSince(registration_start);
+  }
+
   PipelineOptions options;
   GridSceneFlowEstimation<pcl::PointXYZRGB> flow_estimation;
   RigidMotionSegmentation<pcl::PointXYZRGB> segmentation;
   StaticSceneRegistration<pcl::PointXYZRGB> registration;
+  StaticSceneRegistration<pcl::PointXYZRGB> keyframe_registration;
+  pcl::PointCloud<PointFlow>::Ptr keyframe_flow =
+      pcl::make_shared<pcl::PointCloud<PointFlow>>();
+  Eigen::Matrix4d T_world_keyframe = Eigen::Matrix4d::Identity();
+  bool keyframe_is_previous = false; ///< the keyframe is the previous frame
+  std::size_t keyframe_inliers = 0;  ///< inliers of the first fit to the keyframe
   StaticSetSelection<pcl::PointXYZRGB> selection;
   InlierNoiseTracker noise_tracker;
   Cloud::ConstPtr previous;
@@ -192,6 +271,10 @@ OdometryPipeline::process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& clo
   else {
     p.track(cloud);
     result.T_world_curr = p.T_world_prev * rigidInverse(result.T_curr_prev);
+    if (p.options.keyframes) {
+      p.trackKeyframe(cloud);
+      result.T_curr_prev = rigidInverse(result.T_world_curr) * p.T_world_prev;
+    }
     if (p.frames % 100 == 0)
       orthonormalize(result.T_world_curr);
     p.T_curr_prev_predicted = result.T_curr_prev;

@@ -64,6 +64,14 @@ PipelineOptions::table()
       makeField("use_segmentation", &P::use_segmentation, R::any(),
                 "0 = ablation: every valid flow cell is static"),
       makeField("threads", &P::threads, R::atLeast(1), "worker threads"),
+      makeField("keyframes", &P::keyframes, R::any(),
+                "0 = frame-to-frame registration only"),
+      makeField("keyframe_min_overlap", &P::keyframe_min_overlap, R{0, 1, true, false},
+                "new keyframe below this share of its first fit's inliers"),
+      makeField("keyframe_max_distance", &P::keyframe_max_distance, R::above(0),
+                "new keyframe beyond this distance from it (m)"),
+      makeField("keyframe_max_angle", &P::keyframe_max_angle, R::above(0),
+                "new keyframe beyond this rotation from it (rad)"),
   });
   return table;
 }
@@ -86,7 +94,10 @@ pipelineConfigTable()
                  StaticSetSelectionParameters::table().fields()),
       nestFields("pipeline", &P::inlier_noise,
                  InlierNoiseTrackerParameters::table().fields()),
-      prefixFields("pipeline", {own.field("threads")})};
+      prefixFields("pipeline", {own.field("threads"), own.field("keyframes"),
+                                own.field("keyframe_min_overlap"),
+                                own.field("keyframe_max_distance"),
+                                own.field("keyframe_max_angle")})};
   return table;
 }
 

@@ -48,9 +48,19 @@ struct DYNVO_EXPORTS PipelineOptions {
   /// and pipeline.min_inlier_threshold), bounded above by segmentation.inlier_threshold.
   InlierNoiseTrackerParameters inlier_noise;
   unsigned threads = 1; ///< worker threads; results do not depend on it
+  /// Keyframe registration (docs/algorithm.md §7.3): the static cells of each frame are also
+  /// registered against the current keyframe, which gives the pose; false: frame to frame.
+  bool keyframes = true;
+  /// A new keyframe is taken when the inliers of the fit to the keyframe drop below this
+  /// share of those of the first fit to it (static overlap, (0, 1]) ...
+  double keyframe_min_overlap = 0.6;
+  double keyframe_max_distance =
+      0.3;                          ///< ... or the camera moved farther from it (m) ...
+  double keyframe_max_angle = 0.35; ///< ... or turned by more (rad, 20 deg)
 
-  /// Names, units and ranges of the pipeline's own fields use_segmentation and threads; the
-  /// modules' fields, static_set's and inlier_noise's are in their Parameters::table().
+  /// Names, units and ranges of the pipeline's own fields (use_segmentation, threads and
+  /// the keyframe policy); the modules' fields, static_set's and inlier_noise's are in their
+  /// Parameters::table().
   static const ParameterTable<PipelineOptions>& table();
 
   /// \throws std::invalid_argument when a module's parameters or a pipeline value are invalid
@@ -75,6 +85,11 @@ struct FrameResult {
   /// no ego-motion (too few static cells, or a bad frame: see error); T_curr_prev is then
   /// the constant-velocity prediction
   bool lost = false;
+  /// this frame became the keyframe later frames are registered against
+  bool keyframe = false;
+  /// inliers of the fit to the keyframe over those of the first fit to it (1 for the first
+  /// fit; 0 when the fit failed or keyframes are off)
+  double keyframe_overlap = 0.0;
   /// segments[0] = static background pixels, then moving objects (pcl::PointIndices each)
   std::vector<pcl::PointIndices> segments;
   std::vector<std::uint8_t> segment_labels; ///< label id of each segment (1 = static)

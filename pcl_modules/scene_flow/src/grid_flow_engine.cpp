@@ -141,8 +141,8 @@ struct GridFlowEngine::Frame {
 };
 
 GridFlowEngine::GridFlowEngine()
-    : current_(std::make_unique<Frame>())
-    , previous_(std::make_unique<Frame>())
+    : current_(std::make_shared<Frame>())
+    , previous_(std::make_shared<Frame>())
 {
 }
 
@@ -157,7 +157,10 @@ GridFlowEngine::prepare(Slot slot,
                         const GridSceneFlowParameters& params,
                         unsigned threads)
 {
-  Frame& frame = slot == Slot::current ? *current_ : *previous_;
+  std::shared_ptr<Frame>& stored = slot == Slot::current ? current_ : previous_;
+  if (stored == keyframe_)
+    stored = std::make_shared<Frame>();
+  Frame& frame = *stored;
   frame.width = width;
   frame.height = height;
   frame.preprocessing.setParameters(params.depth);
@@ -179,6 +182,18 @@ GridFlowEngine::shiftCurrentToPrevious()
   std::swap(current_, previous_);
 }
 
+void
+GridFlowEngine::keepCurrentAsKeyframe()
+{
+  keyframe_ = current_;
+}
+
+void
+GridFlowEngine::clearKeyframe()
+{
+  keyframe_.reset();
+}
+
 const std::vector<float>&
 GridFlowEngine::depth(Slot slot) const
 {
@@ -191,49 +206,122 @@ GridFlowEngine::compute(const GridSceneFlowParameters& params,
                         unsigned threads,
                         pcl::PointCloud<PointFlow>& flow) const
 {
+  track(*previous_, params, intrinsics, threads, nullptr, params.max_pyramid_level,
+        flow);
+}
+
+void
+GridFlowEngine::computeToKeyframe(const GridSceneFlowParameters& params,
+                                  const CameraIntrinsics& intrinsics,
+                                  unsigned threads,
+                                  const Eigen::Matrix4f& T_keyframe_current,
+                                  int max_level,
+                                  pcl::PointCloud<PointFlow>& flow) const
+{
+  if (!keyframe_)
+    throw std::logic_error(
+        "[dynvo::detail::GridFlowEngine::computeToKeyframe] no keyframe kept");
+  track(*keyframe_, params, intrinsics, threads, &T_keyframe_current,
+        std::clamp(max_level, 0, params.max_pyramid_level), flow);
+}
+
+void
+GridFlowEngine::track(const Frame& reference,
+                      const GridSceneFlowParameters& params,
+                      const CameraIntrinsics& intrinsics,
+                      unsigned threads,
+                      const Eigen::Matrix4f* T_reference_current,
+                      int max_level,
+                      pcl::PointCloud<PointFlow>& flow) const
+{
   const Frame& curr = *current_;
-  const Frame& prev = *previous_;
+  const Frame& prev = reference;
   const int width = static_cast<int>(curr.width);
   const int height = static_cast<int>(curr.height);
   const int cell = params.cell_size;
   const int cols = width / cell;
   const int rows = height / cell;
   const std::size_t n = static_cast<std::size_t>(cols) * rows;
+  const int r = params.depth_window_radius;
 
+  // c_i and the depth b_i is read at (NaN: none).
   std::vector<cv::Point2f> centres(n);
-  for (int r = 0; r < rows; ++r)
-    for (int c = 0; c < cols; ++c)
-      centres[static_cast<std::size_t>(r) * cols + c] =
-          cv::Point2f(static_cast<float>(c * cell + cell / 2),
-                      static_cast<float>(r * cell + cell / 2));
+  std::vector<float> centre_depth(n);
+  for (int row = 0; row < rows; ++row)
+    for (int c = 0; c < cols; ++c) {
+      const std::size_t i = static_cast<std::size_t>(row) * cols + c;
+      centres[i] = cv::Point2f(static_cast<float>(c * cell + cell / 2),
+                               static_cast<float>(row * cell + cell / 2));
+      float z_b = centreDepth(curr.depth, width, height, c * cell + cell / 2,
+                              row * cell + cell / 2);
+      if (r > 0 && !std::isnan(z_b))
+        z_b = windowDepth(curr.depth, width, height, centres[i], z_b, r,
+                          params.depth_edge_tolerance);
+      centre_depth[i] = z_b;
+    }
 
-  // Track every centre c_i from I^k into I^{k-1} (p_i), then p_i back into I^k (c'_i).
-  std::vector<cv::Point2f> tracked(n);
+  // Cells to track, and where each starts in the reference frame when seeded: the
+  // projection of T_reference_current * b_i (cells without depth or seed are left out).
+  std::vector<std::size_t> tracked_cells;
+  std::vector<cv::Point2f> seeds;
+  tracked_cells.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!T_reference_current) {
+      tracked_cells.push_back(i);
+      continue;
+    }
+    if (std::isnan(centre_depth[i]))
+      continue;
+    const Eigen::Vector3f q =
+        (*T_reference_current *
+         intrinsics.backproject(centres[i].x, centres[i].y, centre_depth[i])
+             .homogeneous())
+            .head<3>();
+    if (!(q.z() > 0.0f))
+      continue;
+    const Eigen::Vector2f seed = intrinsics.project(q);
+    if (!(seed.x() >= 0.0f && seed.y() >= 0.0f && seed.x() <= width - 1.0f &&
+          seed.y() <= height - 1.0f))
+      continue;
+    tracked_cells.push_back(i);
+    seeds.emplace_back(seed.x(), seed.y());
+  }
+
+  // Track every selected centre c_i from I^k into the reference (p_i), then p_i back
+  // into I^k (c'_i).
+  const std::size_t m = tracked_cells.size();
+  std::vector<cv::Point2f> tracked(n, cv::Point2f(NaN, NaN));
   std::vector<std::uint8_t> valid2d(n, 0);
   const cv::Size window(params.window_size, params.window_size);
   const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
                                   params.max_iterations, params.epsilon);
   const float fb2 =
       params.forward_backward_threshold * params.forward_backward_threshold;
-  const unsigned stripes = static_cast<unsigned>(std::min<std::size_t>(threads, n));
+  const unsigned stripes = static_cast<unsigned>(std::min<std::size_t>(threads, m));
   runStripes(stripes, [&](unsigned s) {
-    const auto [begin, end] = stripeRange(n, stripes, s);
-    const std::vector<cv::Point2f> from(centres.begin() + begin, centres.begin() + end);
+    const auto [begin, end] = stripeRange(m, stripes, s);
+    std::vector<cv::Point2f> from;
+    for (std::size_t k = begin; k < end; ++k)
+      from.push_back(centres[tracked_cells[k]]);
     std::vector<cv::Point2f> to;
+    if (T_reference_current)
+      to.assign(seeds.begin() + begin, seeds.begin() + end);
     std::vector<std::uint8_t> status;
     cv::calcOpticalFlowPyrLK(curr.pyramid, prev.pyramid, from, to, status,
-                             cv::noArray(), window, params.max_pyramid_level, criteria,
-                             0, params.min_eigen_threshold);
+                             cv::noArray(), window, max_level, criteria,
+                             T_reference_current ? cv::OPTFLOW_USE_INITIAL_FLOW : 0,
+                             params.min_eigen_threshold);
     std::vector<cv::Point2f> forward;
     std::vector<std::size_t> index;
     for (std::size_t k = 0; k < from.size(); ++k) {
-      tracked[begin + k] = to[k];
+      const std::size_t i = tracked_cells[begin + k];
+      tracked[i] = to[k];
       const cv::Point2f& p = to[k];
       // p_i inside [1, W-2] x [1, H-2]: the 2x2 bilinear depth footprint stays in the image.
       if (status[k] && p.x >= 1.0f && p.y >= 1.0f && p.x <= width - 2.0f &&
           p.y <= height - 2.0f) {
         forward.push_back(p);
-        index.push_back(begin + k);
+        index.push_back(i);
       }
     }
     if (forward.empty())
@@ -241,8 +329,8 @@ GridFlowEngine::compute(const GridSceneFlowParameters& params,
     std::vector<cv::Point2f> back;
     if (params.forward_backward_check == ForwardBackwardCheck::full) {
       cv::calcOpticalFlowPyrLK(prev.pyramid, curr.pyramid, forward, back, status,
-                               cv::noArray(), window, params.max_pyramid_level,
-                               criteria, 0, params.min_eigen_threshold);
+                               cv::noArray(), window, max_level, criteria, 0,
+                               params.min_eigen_threshold);
     }
     else {
       for (const std::size_t i : index)
@@ -269,12 +357,7 @@ GridFlowEngine::compute(const GridSceneFlowParameters& params,
     f.valid_2d = valid2d[i];
     f.prev_u = f.valid_2d ? p.x : NaN;
     f.prev_v = f.valid_2d ? p.y : NaN;
-    const int r = params.depth_window_radius;
-    float z_b = centreDepth(curr.depth, width, height, static_cast<int>(c.x),
-                            static_cast<int>(c.y));
-    if (r > 0 && !std::isnan(z_b))
-      z_b = windowDepth(curr.depth, width, height, c, z_b, r,
-                        params.depth_edge_tolerance);
+    const float z_b = centre_depth[i];
     f.getVector3fMap() = std::isnan(z_b) ? Eigen::Vector3f::Constant(NaN)
                                          : intrinsics.backproject(c.x, c.y, z_b);
     f.prev_x = f.prev_y = f.prev_z = NaN;

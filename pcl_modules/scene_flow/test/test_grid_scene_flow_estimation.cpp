@@ -228,6 +228,61 @@ TYPED_TEST(GridSceneFlowTest, KnownCameraMotionIsRecoveredForwardAndInverse)
   }
 }
 
+TYPED_TEST(GridSceneFlowTest, KeyframeFlowStartsFromThePredictionAndOutlivesLaterFrames)
+{
+  const auto scene = staticRoom();
+  // Keyframe a, then b and c: c is 9 cm and 5 deg from a, 10-16 px of flow at this size,
+  // beyond what LK on the finest level finds from c_i alone (a 13 px window).
+  const Eigen::Isometry3d T_world_a = Eigen::Isometry3d::Identity();
+  const Eigen::Isometry3d T_world_b = pose(0.5, 2.0, 0.3, 0.03, -0.01, 0.02);
+  const Eigen::Isometry3d T_world_c = pose(1.0, 5.0, 0.6, 0.08, -0.02, 0.04);
+  auto& estimation = this->estimation_;
+  this->run(this->view(scene, T_world_b).cloud, this->view(scene, T_world_a).cloud);
+  ASSERT_TRUE(estimation.setCurrentAsKeyframe());
+  // b and c are prepared into the slots after the keyframe: its pyramid and depth must stay.
+  for (const auto& T_world : {T_world_b, T_world_c}) {
+    estimation.shiftCurrentToPrevious();
+    estimation.setInputCloud(this->view(scene, T_world).cloud);
+    estimation.compute(this->flow_);
+  }
+  const Eigen::Isometry3d T_a_c = T_world_a.inverse() * T_world_c;
+  const auto track = [&](const Eigen::Isometry3d& seed_motion) {
+    FlowCloud flow;
+    estimation.computeToKeyframe(seed_motion.matrix().cast<float>(), 0, flow);
+    expectCellContract(flow);
+    std::vector<double> error_2d;
+    for (const PointFlow& f : flow)
+      if (f.valid_3d) {
+        const Eigen::Vector2f p_true =
+            this->intrinsics_.project((T_a_c * currPoint(f)).cast<float>());
+        error_2d.push_back((Eigen::Vector2f(f.prev_u, f.prev_v) - p_true).norm());
+      }
+    return error_2d;
+  };
+  // Seeded with the true motion: tracked as well as a small frame-to-frame motion (0.2 px,
+  // KnownCameraMotionIsRecoveredForwardAndInverse); cells whose window leaves the image or
+  // straddles the board's outline may be rejected.
+  const auto seeded = track(T_a_c);
+  ASSERT_GE(seeded.size(), this->flow_.size() * 7 / 10);
+  EXPECT_LT(median(seeded), 0.2);
+  // Seeded with a prediction 2 cm and 1 deg off (a lost frame's constant velocity): still
+  // within the window's reach on the finest level.
+  const auto off = track(T_a_c * pose(0.0, 1.0, 0.0, 0.02, 0.0, 0.0));
+  ASSERT_GE(off.size(), this->flow_.size() * 7 / 10);
+  EXPECT_LT(median(off), 0.2);
+  // Without the prediction (identity) the finest level alone does not reach the keyframe
+  // positions: few cells pass the forward-backward check, and not at the true positions.
+  const auto unseeded = track(Eigen::Isometry3d::Identity());
+  EXPECT_TRUE(unseeded.size() < seeded.size() / 2 || median(unseeded) > 1.0);
+
+  // New parameters drop the keyframe (its pyramid was built with the old ones).
+  estimation.setWindowSize(15);
+  EXPECT_EQ(estimation.getKeyframeCloud(), nullptr);
+  FlowCloud flow;
+  estimation.computeToKeyframe(T_a_c.matrix().cast<float>(), 0, flow);
+  EXPECT_TRUE(flow.empty());
+}
+
 TYPED_TEST(GridSceneFlowTest, MovingObjectCellsCarryTheObjectMotion)
 {
   auto scene = staticRoom();

@@ -9,6 +9,8 @@
 
 #include <pcl/point_cloud.h>
 
+#include <Eigen/Core>
+
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -49,6 +51,16 @@ public:
   /// The current slot becomes the previous one (no copy); the current slot is then stale.
   void shiftCurrentToPrevious();
 
+  /// The prepared current slot is also kept as the keyframe (shared, no copy) until the
+  /// next call; preparing a slot that holds the keyframe gives that slot new buffers.
+  void keepCurrentAsKeyframe();
+
+  /// Drops the keyframe.
+  void clearKeyframe();
+
+  /// A keyframe is kept.
+  bool hasKeyframe() const { return keyframe_ != nullptr; }
+
   /** \brief Grid scene flow from the previous to the current slot (docs/algorithm.md §1.2).
    * Both slots must have been prepared with the same size and params.
    * \param[out] flow organized (width / cell_size) x (height / cell_size) cloud
@@ -58,13 +70,38 @@ public:
                unsigned threads,
                pcl::PointCloud<PointFlow>& flow) const;
 
+  /** \brief Grid scene flow from the keyframe to the current slot, seeded (docs/algorithm.md
+   * §7.3): each cell with depth b_i starts at the projection of T_keyframe_current * b_i in
+   * the keyframe and is tracked on pyramid levels 0..max_level only; cells without depth at
+   * c_i are not tracked. Same output as compute(), prev_* in the keyframe's camera frame.
+   * \param[in] max_level highest pyramid level used, clamped to params.max_pyramid_level
+   */
+  void computeToKeyframe(const GridSceneFlowParameters& params,
+                         const CameraIntrinsics& intrinsics,
+                         unsigned threads,
+                         const Eigen::Matrix4f& T_keyframe_current,
+                         int max_level,
+                         pcl::PointCloud<PointFlow>& flow) const;
+
   /// Preprocessed depth (metres, NaN = invalid) of a prepared slot, row-major.
   const std::vector<float>& depth(Slot slot) const;
 
 private:
   struct Frame;
-  std::unique_ptr<Frame> current_;
-  std::unique_ptr<Frame> previous_;
+
+  /// Tracks the cells of the current slot into reference (seeded when T_reference_current
+  /// is given) and back-projects both ends: compute() and computeToKeyframe().
+  void track(const Frame& reference,
+             const GridSceneFlowParameters& params,
+             const CameraIntrinsics& intrinsics,
+             unsigned threads,
+             const Eigen::Matrix4f* T_reference_current,
+             int max_level,
+             pcl::PointCloud<PointFlow>& flow) const;
+
+  std::shared_ptr<Frame> current_;
+  std::shared_ptr<Frame> previous_;
+  std::shared_ptr<const Frame> keyframe_; ///< shares one of the slots' frames, or none
 };
 
 } // namespace dynvo::detail

@@ -36,6 +36,8 @@ namespace dynvo {
  *
  * Sequences: after compute(), shiftCurrentToPrevious() turns the current frame (its grey pyramid
  * and preprocessed depth) into the previous one, so each frame is prepared once.
+ * setCurrentAsKeyframe() also keeps it as a keyframe, and computeToKeyframe() tracks later
+ * frames into it from a predicted motion.
  * \code
  * dynvo::GridSceneFlowEstimation<pcl::PointXYZRGB> flow_estimation;
  * flow_estimation.setCameraIntrinsics(dynvo::CameraIntrinsics::fromPreset("fr1"));
@@ -87,6 +89,27 @@ public:
    *         e.g. min_depth >= max_depth after setMinDepth()/setMaxDepth()
    */
   void compute(FlowCloud& flow);
+
+  /** \brief Keeps the current frame of the last compute() as the keyframe (its pyramid and
+   * depth map are shared, not copied), replacing the previous keyframe.
+   * \return false (logged with PCL_ERROR) when compute() has not prepared the input cloud
+   */
+  bool setCurrentAsKeyframe();
+
+  /// The keyframe's cloud; null before setCurrentAsKeyframe() or after new parameters.
+  const PointCloudConstPtr& getKeyframeCloud() const { return keyframe_; }
+
+  /** \brief Grid scene flow from the keyframe to the input cloud of the last compute()
+   * (docs/algorithm.md §7.3): as compute(), with prev_* in the keyframe's camera frame.
+   * Each cell with depth starts at its predicted position, the projection of
+   * T_keyframe_current * b_i, and is tracked on pyramid levels 0..max_level only (0: a
+   * good prediction; up to max_pyramid_level when the prediction may be far off).
+   * \param[out] flow organized grid; empty (logged with PCL_ERROR) without a keyframe or a
+   *             prepared input cloud
+   */
+  void computeToKeyframe(const Eigen::Matrix4f& T_keyframe_current,
+                         int max_level,
+                         FlowCloud& flow);
 
   /// \throws std::invalid_argument when intrinsics.validate() fails
   void setCameraIntrinsics(const CameraIntrinsics& intrinsics);
@@ -147,6 +170,7 @@ private:
   CameraIntrinsics intrinsics_;   ///< back-projection (default preset "default")
   unsigned threads_ = 1;          ///< worker threads
   PointCloudConstPtr previous_;   ///< frame k-1
+  PointCloudConstPtr keyframe_;   ///< the kept keyframe, or null
   detail::GridFlowEngine engine_; ///< pyramids and preprocessed depth of both frames
   bool current_ready_ = false;    ///< engine current slot matches input_ and params_
   bool previous_ready_ = false; ///< engine previous slot matches previous_ and params_

@@ -75,6 +75,8 @@ GridSceneFlowEstimation<PointT>::assignParameters(const Parameters& parameters)
   // Pyramids depend on the LK window and levels, depth maps on the depth rules.
   current_ready_ = false;
   previous_ready_ = false;
+  engine_.clearKeyframe();
+  keyframe_.reset();
 }
 
 template <typename PointT>
@@ -162,6 +164,38 @@ GridSceneFlowEstimation<PointT>::compute(FlowCloud& flow)
     prepareFrame(*previous_, detail::GridFlowEngine::Slot::previous);
   previous_ready_ = true;
   engine_.compute(params_, intrinsics_, threads_, flow);
+  flow.header = input_->header;
+}
+
+template <typename PointT>
+bool
+GridSceneFlowEstimation<PointT>::setCurrentAsKeyframe()
+{
+  if (!input_ || !current_ready_) {
+    PCL_ERROR("[dynvo::%s::setCurrentAsKeyframe] the input cloud has not been "
+              "prepared by compute().\n",
+              getClassName().c_str());
+    return false;
+  }
+  engine_.keepCurrentAsKeyframe();
+  keyframe_ = input_;
+  return true;
+}
+
+template <typename PointT>
+void
+GridSceneFlowEstimation<PointT>::computeToKeyframe(
+    const Eigen::Matrix4f& T_keyframe_current, int max_level, FlowCloud& flow)
+{
+  flow.clear();
+  if (!keyframe_ || !input_ || !current_ready_) {
+    PCL_ERROR("[dynvo::%s::computeToKeyframe] %s.\n", getClassName().c_str(),
+              keyframe_ ? "the input cloud has not been prepared by compute()"
+                        : "no keyframe set");
+    return;
+  }
+  engine_.computeToKeyframe(params_, intrinsics_, threads_, T_keyframe_current,
+                            max_level, flow);
   flow.header = input_->header;
 }
 
