@@ -50,6 +50,21 @@ movingCamera(double scale)
   return path;
 }
 
+/** Hand-held fast sweep (see the fast_sweep scenario): panning back and forth with the
+ *  hand swinging along, a slower drift in depth, a small bob and roll. */
+RigidPath
+sweepingCamera()
+{
+  RigidPath path = staticCamera();
+  path.translation = {{Eigen::Vector3d(0.36, 0.0, 0.0), 2.6, 0.0},
+                      {Eigen::Vector3d(0.0, 0.05, 0.0), 4.1, 0.7},
+                      {Eigen::Vector3d(0.0, 0.0, 0.25), 1.3, 0.2}};
+  path.rotation = {{Eigen::Vector3d(0.0, 0.62, 0.0), 2.6, 0.0},
+                   {Eigen::Vector3d(0.06, 0.0, 0.0), 3.3, 1.1},
+                   {Eigen::Vector3d(0.0, 0.0, 0.05), 2.1, 0.4}};
+  return path;
+}
+
 /// Elliptic path: first_axis sin(w s + phase) + second_axis cos(w s + phase).
 std::vector<SineTerm>
 ellipse(const Eigen::Vector3d& first_axis,
@@ -229,6 +244,19 @@ makeScenarios()
                        "camera circling a slowly bobbing box",
                        circling,
                        {bobbing}});
+
+  // A hand-held sweep as fast as the fastest stretches of TUM fr1/desk: the camera pans
+  // back and forth (up to 90 deg/s) while the hand swings sideways (up to 1 m/s), holding
+  // still for 0.75 s after every 2.5 s of motion (0.25 s raised-cosine speed ramps), as
+  // when someone stops to look. A 20 ms exposure blurs the whole image while it moves.
+  scenarios.push_back(
+      {"fast_sweep",
+       "hand-held fast sweep (1 m/s, 90 deg/s) with holds, static room, "
+       "motion blur",
+       sweepingCamera(),
+       {}});
+  scenarios.back().exposure = 0.02;
+  scenarios.back().camera_schedule = {3.25, {{0.0, 2.5}}, 0.25};
   return scenarios;
 }
 

@@ -91,6 +91,8 @@ struct Scenario {
   RigidPath camera; ///< T_world_camera as a function of time (progress = t)
   std::vector<ScriptedBox> objects;
   double exposure = 0.0; ///< colour exposure (s) averaged into motion blur; 0 = sharp
+  /// Progress of the camera's path over time (no windows: always moving)
+  MotionSchedule camera_schedule;
 };
 
 /// The room (same for every scenario).

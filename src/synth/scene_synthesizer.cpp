@@ -32,7 +32,12 @@ constexpr float MIN_COSINE =
 constexpr int ROOM_SURFACES = 6;
 constexpr int FURNITURE_SURFACE_BASE = 6;
 constexpr int OBJECT_SURFACE_BASE = 64;
-constexpr int BLUR_SAMPLES = 7; ///< sub-frames averaged over a motion-blurred exposure
+constexpr int BLUR_SAMPLES = 7; ///< sub-frames averaged over a moving object's exposure
+/// Camera blur: sub-frames are at most this far apart in the image (px), so a streak is
+/// a smooth smear rather than separate copies; the count is capped (rendering cost).
+constexpr double CAMERA_BLUR_STEP = 3.0;
+constexpr int MAX_CAMERA_BLUR_SAMPLES = 9;
+constexpr int BLUR_PROBES = 9; ///< probe pixels per image axis for the streak length
 
 /// Direction towards the (directional) light in the world: above, behind-left.
 Eigen::Vector3d
@@ -121,6 +126,39 @@ frameBox(const Eigen::Isometry3d& T_world_box,
   return box;
 }
 
+/// Longest image path (px) of a scene point seen by `view` (the camera at T_world_mid)
+/// between the camera poses T_world_start and T_world_end; probes a grid of pixels.
+double
+streakLength(const SceneView& view,
+             const CameraIntrinsics& K,
+             int width,
+             int height,
+             const Eigen::Isometry3d& T_world_mid,
+             const Eigen::Isometry3d& T_world_start,
+             const Eigen::Isometry3d& T_world_end)
+{
+  const Eigen::Isometry3d T_start_mid = T_world_start.inverse() * T_world_mid;
+  const Eigen::Isometry3d T_end_mid = T_world_end.inverse() * T_world_mid;
+  double longest = 0.0;
+  for (int i = 0; i < BLUR_PROBES; ++i) {
+    for (int j = 0; j < BLUR_PROBES; ++j) {
+      const int u = (width - 1) * i / (BLUR_PROBES - 1);
+      const int v = (height - 1) * j / (BLUR_PROBES - 1);
+      PixelHit hit;
+      if (!view.cast(u, v, hit))
+        continue;
+      const Eigen::Vector3d p_mid = K.backproject(u, v, hit.surface.z).cast<double>();
+      const Eigen::Vector3d a = T_start_mid * p_mid, b = T_end_mid * p_mid;
+      if (a.z() <= 0.0 || b.z() <= 0.0)
+        continue;
+      const Eigen::Vector2d uv_a(K.fx * a.x() / a.z(), K.fy * a.y() / a.z());
+      const Eigen::Vector2d uv_b(K.fx * b.x() / b.z(), K.fy * b.y() / b.z());
+      longest = std::max(longest, (uv_a - uv_b).norm());
+    }
+  }
+  return longest;
+}
+
 } // namespace
 
 void
@@ -191,7 +229,7 @@ SceneSynthesizer::Impl::scriptAt(double t, double t_previous) const
   // Whole microseconds, so the "%.6f" stamps of the files parse back to these values.
   frame.timestamp = std::round((FIRST_STAMP + t) * 1e6) / 1e6;
   frame.depth_timestamp = std::round((frame.timestamp + DEPTH_STAMP_DELAY) * 1e6) / 1e6;
-  frame.T_world_camera = scenario->camera.pose(t);
+  frame.T_world_camera = scenario->camera.pose(scenario->camera_schedule.progress(t));
   for (const detail::ScriptedBox& box : scenario->objects) {
     const double s = box.schedule.progress(t);
     ObjectState state;
@@ -327,6 +365,32 @@ SceneView::cast(int u, int v, PixelHit& out) const
 }
 
 void
+SceneView::meanColour(const std::vector<SceneView>& exposure,
+                      int u0,
+                      int u1,
+                      int v0,
+                      int v1,
+                      int width,
+                      ColorImage& color)
+{
+  for (int v = v0; v <= v1; ++v) {
+    for (int u = u0; u <= u1; ++u) {
+      float sum[3] = {0.0f, 0.0f, 0.0f};
+      for (const SceneView& view : exposure) {
+        PixelHit hit;
+        view.cast(u, v, hit);
+        for (int channel = 0; channel < 3; ++channel)
+          sum[channel] += hit.rgb[channel];
+      }
+      const std::size_t i = static_cast<std::size_t>(v) * width + u;
+      for (int channel = 0; channel < 3; ++channel)
+        color.data[3 * i + channel] =
+            static_cast<std::uint8_t>(sum[channel] / exposure.size() + 0.5f);
+    }
+  }
+}
+
+void
 SceneView::blurColour(const std::vector<SceneView>& exposure,
                       int width,
                       int height,
@@ -344,23 +408,9 @@ SceneView::blurColour(const std::vector<SceneView>& exposure,
     v1 = any ? std::max(v1, b1) : b1;
     any = true;
   }
-  if (!any)
-    return;
-  for (int v = std::max(v0, 0); v <= std::min(v1, height - 1); ++v) {
-    for (int u = std::max(u0, 0); u <= std::min(u1, width - 1); ++u) {
-      float sum[3] = {0.0f, 0.0f, 0.0f};
-      for (const SceneView& view : exposure) {
-        PixelHit hit;
-        view.cast(u, v, hit);
-        for (int channel = 0; channel < 3; ++channel)
-          sum[channel] += hit.rgb[channel];
-      }
-      const std::size_t i = static_cast<std::size_t>(v) * width + u;
-      for (int channel = 0; channel < 3; ++channel)
-        color.data[3 * i + channel] =
-            static_cast<std::uint8_t>(sum[channel] / exposure.size() + 0.5f);
-    }
-  }
+  if (any)
+    meanColour(exposure, std::max(u0, 0), std::min(u1, width - 1), std::max(v0, 0),
+               std::min(v1, height - 1), width, color);
 }
 
 double
@@ -417,16 +467,30 @@ SceneSynthesizer::render(int k) const
       frame.labels[i] = hit.label;
     }
   }
-  const double exposure = impl_->scenario->exposure;
+  const double exposure = options.motion_blur ? impl_->scenario->exposure : 0.0;
   if (exposure > 0.0) {
-    std::vector<SceneView> views;
-    const double t = k / options.fps;
-    for (int j = 0; j < BLUR_SAMPLES; ++j) {
-      const double offset = exposure * (j / (BLUR_SAMPLES - 1.0) - 0.5);
-      views.emplace_back(impl_->scriptAt(t + offset, t - 1.0 / options.fps),
-                         impl_->intrinsics, options, true);
+    const double t = k / options.fps, t_previous = (k - 1) / options.fps;
+    // n instants evenly spread over the exposure, centred on the colour stamp.
+    const auto exposureViews = [&](int n) {
+      std::vector<SceneView> views;
+      for (int j = 0; j < n; ++j)
+        views.emplace_back(
+            impl_->scriptAt(t + exposure * (j / (n - 1.0) - 0.5), t_previous),
+            impl_->intrinsics, options, true);
+      return views;
+    };
+    // Camera blur over the whole image; none while the camera rests (streak 0 px).
+    const double streak =
+        streakLength(view, impl_->intrinsics, width, height, frame.T_world_camera,
+                     impl_->scriptAt(t - 0.5 * exposure, t_previous).T_world_camera,
+                     impl_->scriptAt(t + 0.5 * exposure, t_previous).T_world_camera);
+    if (streak > 0.0) {
+      const int n = std::min(MAX_CAMERA_BLUR_SAMPLES,
+                             2 + static_cast<int>(streak / CAMERA_BLUR_STEP));
+      SceneView::meanColour(exposureViews(n), 0, width - 1, 0, height - 1, width,
+                            frame.color);
     }
-    SceneView::blurColour(views, width, height, frame.color);
+    SceneView::blurColour(exposureViews(BLUR_SAMPLES), width, height, frame.color);
   }
   if (options.noise) {
     DepthSensorModel::measure(samples, width, height, impl_->intrinsics.fx,

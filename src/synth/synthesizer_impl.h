@@ -66,6 +66,16 @@ public:
   /// Pixel rectangle holding every moving object (inclusive); false when none moves.
   bool movingRectangle(int& u0, int& u1, int& v0, int& v1) const;
 
+  /// Replaces the colour of the pixels [u0, u1] x [v0, v1] (inclusive, inside the
+  /// image) by the mean over the views of one exposure.
+  static void meanColour(const std::vector<SceneView>& exposure,
+                         int u0,
+                         int u1,
+                         int v0,
+                         int v1,
+                         int width,
+                         ColorImage& color);
+
   /// Replaces the colour inside the moving objects' rectangles by the mean over the
   /// views of one exposure (motion blur).
   static void blurColour(const std::vector<SceneView>& exposure,

@@ -55,6 +55,8 @@ struct DYNVO_EXPORTS SynthOptions {
   int height = 480;       ///< image rows (px)
   double fps = 30.0;      ///< frame rate (Hz)
   bool noise = true;      ///< DepthSensorModel on; off = exact depth everywhere
+  /// Motion blur of the scenarios with an exposure; off = colour of the frame's instant
+  bool motion_blur = true;
   /// Intrinsics at 640x480 (scaled with width/height); the "default" preset.
   CameraIntrinsics intrinsics;
 
@@ -81,7 +83,9 @@ struct DYNVO_EXPORTS SynthOptions {
  * Motion: the camera follows sums of sinusoids (about 0.1-0.3 m/s and up to about
  * 4 deg/s; circling_bobbing circles its box at up to 9 deg/s) in the moving-camera
  * scenarios and is fixed (constant, non-identity pose looking 11.5 deg down) in the
- * static ones. Objects follow smooth 6-DoF scripts (sinusoids, Hermite splines through
+ * static ones; fast_sweep is a hand-held sweep at up to about 1 m/s and 90 deg/s (the
+ * fastest stretches of TUM fr1/desk) in the static room, moving for 2.5 s and holding
+ * still for 0.75 s in turn (0.25 s raised-cosine speed ramps). Objects follow smooth 6-DoF scripts (sinusoids, Hermite splines through
  * waypoints, or a shallow arc) at 0.3-5 cm per frame at 30 Hz, except the cube of
  * thrown_object (about 13 cm, up to 35 px per frame); stop_and_go and enter_stop_leave
  * objects rest for stretches and move with 0.25 s raised-cosine speed ramps. Object k is "moving" at frame k exactly when its pose
@@ -92,9 +96,16 @@ struct DYNVO_EXPORTS SynthOptions {
  * at depth edges, at grazing angles and on dark surfaces, speckle, 0.5-4.5 m range).
  * Without noise the depth is the exact ray depth everywhere.
  *
- * Motion blur: scenarios with an exposure (thrown_object) average the colour of
- * BLUR_SAMPLES instants across it inside the moving objects' pixel rectangle; depth and
- * labels show the frame's instant.
+ * Motion blur (SynthOptions::motion_blur): scenarios with an exposure (20 ms in
+ * thrown_object and fast_sweep, the middle of a Kinect v1's 10-30 ms indoor auto
+ * exposure), centred on the colour stamp, average the colour of evenly spread instants
+ * across it. Camera motion blurs the whole image: as many instants as keep the
+ * image of every scene point moving at most CAMERA_BLUR_STEP (3 px) between two (the
+ * streak is measured on a grid of probe pixels), at most MAX_CAMERA_BLUR_SAMPLES (9,
+ * for the rendering cost; longer streaks get wider gaps); a camera at rest over the
+ * exposure leaves the frame's instant untouched. Moving objects then average
+ * BLUR_SAMPLES (7) instants inside their pixel rectangle. Depth and labels show the
+ * frame's instant.
  *
  * Timestamps: colour stamp FIRST_STAMP + k / fps, depth stamp DEPTH_STAMP_DELAY later,
  * both rounded to whole microseconds (the "%.6f" of the files parses back exactly);
