@@ -190,8 +190,10 @@ struct OdometryPipeline::Impl {
     // Without a frame-to-frame estimate the guess is the constant-velocity prediction: the
     // whole pyramid is searched around it.
     const int levels = result.lost ? options.scene_flow.max_pyramid_level : 0;
-    flow_estimation.computeToKeyframe(T_keyframe_guess.cast<float>(), levels,
-                                      *keyframe_flow);
+    // Only the frame-to-frame static set is tracked (every cell after a lost frame).
+    flow_estimation.computeToKeyframe(
+        T_keyframe_guess.cast<float>(), levels,
+        result.lost ? FlowGrid() : selection.getStaticCells(), *keyframe_flow);
     result.times.scene_flow_ms += millisecondsSince(flow_start);
 
     const auto registration_start = Clock::now();

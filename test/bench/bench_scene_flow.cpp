@@ -96,6 +96,45 @@ BENCHMARK(BM_GridSceneFlowPerFrame)
       return *std::min_element(v.begin(), v.end());
     });
 
+/// The flow to a keyframe (docs/algorithm.md §7.3) that the pipeline adds per frame: frame 0
+/// is the keyframe, frames 1-5 are tracked into it on the finest level from their own
+/// positions (the seed a static camera gives; fr1/xyz moves 1-4 px over these frames, within
+/// the reach of a good prediction).
+/// Frame preparation is not timed here (BM_GridSceneFlowPerFrame has it). Arg: thread count.
+void
+BM_KeyframeFlowPerFrame(benchmark::State& state)
+{
+  if (skipWithoutData(state))
+    return;
+  dynvo::GridSceneFlowEstimation<pcl::PointXYZRGB> estimation;
+  estimation.setCameraIntrinsics(dynvo::CameraIntrinsics::fromPreset("fr1"));
+  estimation.setNumberOfThreads(static_cast<unsigned>(state.range(0)));
+  pcl::PointCloud<dynvo::PointFlow> flow;
+  estimation.setPreviousCloud(frames()[1].cloud);
+  estimation.setInputCloud(frames()[0].cloud);
+  estimation.compute(flow);
+  estimation.setCurrentAsKeyframe();
+  const std::size_t n = std::min<std::size_t>(frames().size() - 1, 5);
+  std::size_t step = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    estimation.shiftCurrentToPrevious();
+    estimation.setInputCloud(frames()[1 + step++ % n].cloud);
+    estimation.compute(flow);
+    state.ResumeTiming();
+    estimation.computeToKeyframe(Eigen::Matrix4f::Identity(), 0, dynvo::FlowGrid(),
+                                 flow);
+    benchmark::DoNotOptimize(flow.points.data());
+  }
+}
+BENCHMARK(BM_KeyframeFlowPerFrame)
+    ->ArgNames({"threads"})
+    ->Args({1})
+    ->Args({2})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(1.0);
+
 /// Depth preprocessing alone (docs/algorithm.md §1.1) on one VGA depth map. Arg: thread count.
 void
 BM_DepthPreprocessing(benchmark::State& state)

@@ -206,7 +206,7 @@ GridFlowEngine::compute(const GridSceneFlowParameters& params,
                         unsigned threads,
                         pcl::PointCloud<PointFlow>& flow) const
 {
-  track(*previous_, params, intrinsics, threads, nullptr, params.max_pyramid_level,
+  track(*previous_, params, intrinsics, threads, nullptr, {}, params.max_pyramid_level,
         flow);
 }
 
@@ -215,13 +215,14 @@ GridFlowEngine::computeToKeyframe(const GridSceneFlowParameters& params,
                                   const CameraIntrinsics& intrinsics,
                                   unsigned threads,
                                   const Eigen::Matrix4f& T_keyframe_current,
+                                  const std::vector<std::uint8_t>& selected,
                                   int max_level,
                                   pcl::PointCloud<PointFlow>& flow) const
 {
   if (!keyframe_)
     throw std::logic_error(
         "[dynvo::detail::GridFlowEngine::computeToKeyframe] no keyframe kept");
-  track(*keyframe_, params, intrinsics, threads, &T_keyframe_current,
+  track(*keyframe_, params, intrinsics, threads, &T_keyframe_current, selected,
         std::clamp(max_level, 0, params.max_pyramid_level), flow);
 }
 
@@ -231,6 +232,7 @@ GridFlowEngine::track(const Frame& reference,
                       const CameraIntrinsics& intrinsics,
                       unsigned threads,
                       const Eigen::Matrix4f* T_reference_current,
+                      const std::vector<std::uint8_t>& selected,
                       int max_level,
                       pcl::PointCloud<PointFlow>& flow) const
 {
@@ -261,7 +263,8 @@ GridFlowEngine::track(const Frame& reference,
     }
 
   // Cells to track, and where each starts in the reference frame when seeded: the
-  // projection of T_reference_current * b_i (cells without depth or seed are left out).
+  // projection of T_reference_current * b_i (unselected cells and those without depth or
+  // seed are left out).
   std::vector<std::size_t> tracked_cells;
   std::vector<cv::Point2f> seeds;
   tracked_cells.reserve(n);
@@ -270,7 +273,7 @@ GridFlowEngine::track(const Frame& reference,
       tracked_cells.push_back(i);
       continue;
     }
-    if (std::isnan(centre_depth[i]))
+    if (std::isnan(centre_depth[i]) || (!selected.empty() && !selected[i]))
       continue;
     const Eigen::Vector3f q =
         (*T_reference_current *

@@ -248,7 +248,8 @@ TYPED_TEST(GridSceneFlowTest, KeyframeFlowStartsFromThePredictionAndOutlivesLate
   const Eigen::Isometry3d T_a_c = T_world_a.inverse() * T_world_c;
   const auto track = [&](const Eigen::Isometry3d& seed_motion) {
     FlowCloud flow;
-    estimation.computeToKeyframe(seed_motion.matrix().cast<float>(), 0, flow);
+    estimation.computeToKeyframe(seed_motion.matrix().cast<float>(), 0,
+                                 dynvo::FlowGrid(), flow);
     expectCellContract(flow);
     std::vector<double> error_2d;
     for (const PointFlow& f : flow)
@@ -275,11 +276,33 @@ TYPED_TEST(GridSceneFlowTest, KeyframeFlowStartsFromThePredictionAndOutlivesLate
   const auto unseeded = track(Eigen::Isometry3d::Identity());
   EXPECT_TRUE(unseeded.size() < seeded.size() / 2 || median(unseeded) > 1.0);
 
+  // Only the selected cells are tracked: here the left half of the grid.
+  dynvo::FlowGrid left(TestFixture::WIDTH, TestFixture::HEIGHT, 16);
+  for (std::size_t i = 0; i < left.size(); ++i)
+    left.labels[i] =
+        i % left.cols < left.cols / 2 ? dynvo::LABEL_STATIC : dynvo::LABEL_NONE;
+  FlowCloud flow;
+  estimation.computeToKeyframe(T_a_c.matrix().cast<float>(), 0, left, flow);
+  ASSERT_EQ(flow.size(), left.size());
+  std::size_t tracked_left = 0;
+  for (std::size_t i = 0; i < flow.size(); ++i) {
+    if (left.labels[i] == dynvo::LABEL_NONE)
+      EXPECT_FALSE(flow[i].valid_2d) << "cell " << i;
+    else
+      tracked_left += flow[i].valid_3d;
+  }
+  EXPECT_GE(tracked_left, left.size() / 2 * 7 / 10);
+  // A grid of another geometry is refused.
+  estimation.computeToKeyframe(
+      T_a_c.matrix().cast<float>(), 0,
+      dynvo::FlowGrid(TestFixture::WIDTH, TestFixture::HEIGHT, 8), flow);
+  EXPECT_TRUE(flow.empty());
+
   // New parameters drop the keyframe (its pyramid was built with the old ones).
   estimation.setWindowSize(15);
   EXPECT_EQ(estimation.getKeyframeCloud(), nullptr);
-  FlowCloud flow;
-  estimation.computeToKeyframe(T_a_c.matrix().cast<float>(), 0, flow);
+  estimation.computeToKeyframe(T_a_c.matrix().cast<float>(), 0, dynvo::FlowGrid(),
+                               flow);
   EXPECT_TRUE(flow.empty());
 }
 

@@ -71,15 +71,18 @@ public:
                pcl::PointCloud<PointFlow>& flow) const;
 
   /** \brief Grid scene flow from the keyframe to the current slot, seeded (docs/algorithm.md
-   * §7.3): each cell with depth b_i starts at the projection of T_keyframe_current * b_i in
-   * the keyframe and is tracked on pyramid levels 0..max_level only; cells without depth at
-   * c_i are not tracked. Same output as compute(), prev_* in the keyframe's camera frame.
+   * §7.3): each selected cell with depth b_i starts at the projection of
+   * T_keyframe_current * b_i in the keyframe and is tracked on pyramid levels 0..max_level
+   * only; other cells are not tracked. Same output as compute(), prev_* in the keyframe's
+   * camera frame.
+   * \param[in] selected per cell, non-zero to track it; empty: every cell
    * \param[in] max_level highest pyramid level used, clamped to params.max_pyramid_level
    */
   void computeToKeyframe(const GridSceneFlowParameters& params,
                          const CameraIntrinsics& intrinsics,
                          unsigned threads,
                          const Eigen::Matrix4f& T_keyframe_current,
+                         const std::vector<std::uint8_t>& selected,
                          int max_level,
                          pcl::PointCloud<PointFlow>& flow) const;
 
@@ -90,12 +93,14 @@ private:
   struct Frame;
 
   /// Tracks the cells of the current slot into reference (seeded when T_reference_current
-  /// is given) and back-projects both ends: compute() and computeToKeyframe().
+  /// is given, then only the selected ones) and back-projects both ends: compute() and
+  /// computeToKeyframe().
   void track(const Frame& reference,
              const GridSceneFlowParameters& params,
              const CameraIntrinsics& intrinsics,
              unsigned threads,
              const Eigen::Matrix4f* T_reference_current,
+             const std::vector<std::uint8_t>& selected,
              int max_level,
              pcl::PointCloud<PointFlow>& flow) const;
 

@@ -4,6 +4,7 @@
 
 #include <dynvo/common/camera.h>
 #include <dynvo/common/export.h>
+#include <dynvo/common/flow_grid.h>
 #include <dynvo/common/point_types.h>
 #include <dynvo/scene_flow/grid_flow_engine.h>
 #include <dynvo/scene_flow/grid_scene_flow_parameters.h>
@@ -104,11 +105,14 @@ public:
    * Each cell with depth starts at its predicted position, the projection of
    * T_keyframe_current * b_i, and is tracked on pyramid levels 0..max_level only (0: a
    * good prediction; up to max_pyramid_level when the prediction may be far off).
+   * \param[in] cells the cells to track, labelled LABEL_STATIC (e.g. the static set of the
+   *            frame-to-frame fit); an empty grid (FlowGrid()) tracks every cell
    * \param[out] flow organized grid; empty (logged with PCL_ERROR) without a keyframe or a
-   *             prepared input cloud
+   *             prepared input cloud, or when cells is not empty and not the flow's grid
    */
   void computeToKeyframe(const Eigen::Matrix4f& T_keyframe_current,
                          int max_level,
+                         const FlowGrid& cells,
                          FlowCloud& flow);
 
   /// \throws std::invalid_argument when intrinsics.validate() fails
@@ -174,8 +178,9 @@ private:
   detail::GridFlowEngine engine_; ///< pyramids and preprocessed depth of both frames
   bool current_ready_ = false;    ///< engine current slot matches input_ and params_
   bool previous_ready_ = false; ///< engine previous slot matches previous_ and params_
-  std::vector<std::uint8_t> grey_; ///< conversion buffer (grey levels)
-  std::vector<float> depth_;       ///< conversion buffer (metres)
+  std::vector<std::uint8_t> grey_;     ///< conversion buffer (grey levels)
+  std::vector<float> depth_;           ///< conversion buffer (metres)
+  std::vector<std::uint8_t> selected_; ///< cells computeToKeyframe() tracks
 };
 
 } // namespace dynvo

@@ -185,7 +185,10 @@ GridSceneFlowEstimation<PointT>::setCurrentAsKeyframe()
 template <typename PointT>
 void
 GridSceneFlowEstimation<PointT>::computeToKeyframe(
-    const Eigen::Matrix4f& T_keyframe_current, int max_level, FlowCloud& flow)
+    const Eigen::Matrix4f& T_keyframe_current,
+    int max_level,
+    const FlowGrid& cells,
+    FlowCloud& flow)
 {
   flow.clear();
   if (!keyframe_ || !input_ || !current_ready_) {
@@ -194,8 +197,19 @@ GridSceneFlowEstimation<PointT>::computeToKeyframe(
                         : "no keyframe set");
     return;
   }
+  const FlowGrid grid(input_->width, input_->height,
+                      static_cast<std::uint32_t>(params_.cell_size));
+  if (cells.size() > 0 && !cells.sameGeometry(grid)) {
+    PCL_ERROR(
+        "[dynvo::%s::computeToKeyframe] the cells are not the flow's %ux%u grid.\n",
+        getClassName().c_str(), grid.cols, grid.rows);
+    return;
+  }
+  selected_.clear();
+  for (const std::uint8_t label : cells.labels)
+    selected_.push_back(label == LABEL_STATIC);
   engine_.computeToKeyframe(params_, intrinsics_, threads_, T_keyframe_current,
-                            max_level, flow);
+                            selected_, max_level, flow);
   flow.header = input_->header;
 }
 
