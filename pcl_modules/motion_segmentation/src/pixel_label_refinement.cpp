@@ -228,31 +228,44 @@ PixelLabelRefinement::refine(const FlowGrid& cells,
       const int u0 = col * cell, v0 = row * cell;
       const int u1 = col + 1 == cols ? static_cast<int>(width) : u0 + cell;
       const int v1 = row + 1 == rows ? static_cast<int>(height) : v0 + cell;
-      // Candidate cells: the labelled ones of the 3x3 window with a reference depth.
-      std::size_t candidates[9];
+      // Candidate cells: the labelled ones of the 3x3 window with a reference depth, with
+      // everything the per-pixel cost needs from them.
+      struct Candidate {
+        float u, v, z, gradient_u, gradient_v, grey;
+        std::uint8_t label;
+      } candidates[9];
       int count = 0;
       bool boundary = false;
-      for (int dr = -1; dr <= 1; ++dr)
-        for (int dc = -1; dc <= 1; ++dc) {
-          const int r = row + dr, c = col + dc;
-          if (r < 0 || r >= rows || c < 0 || c >= cols)
-            continue;
-          const std::size_t k = static_cast<std::size_t>(r) * cols + c;
-          if (filled_[k] == LABEL_NONE || !std::isfinite(cell_depth_[k]))
-            continue;
-          candidates[count++] = k;
-          boundary = boundary || filled_[k] != filled_[i];
-        }
+      // The cell's own centre first: it is nearest to most of its pixels, so the distance
+      // bound below skips most of the others.
+      static constexpr int ORDER[9][2] = {{0, 0},   {-1, 0}, {1, 0},  {0, -1}, {0, 1},
+                                          {-1, -1}, {1, -1}, {-1, 1}, {1, 1}};
+      for (const auto& [dc, dr] : ORDER) {
+        const int r = row + dr, c = col + dc;
+        if (r < 0 || r >= rows || c < 0 || c >= cols)
+          continue;
+        const std::size_t k = static_cast<std::size_t>(r) * cols + c;
+        if (filled_[k] == LABEL_NONE || !std::isfinite(cell_depth_[k]))
+          continue;
+        candidates[count++] = {static_cast<float>(c * cell + cell / 2),
+                               static_cast<float>(r * cell + cell / 2),
+                               cell_depth_[k],
+                               gradient_u_[k],
+                               gradient_v_[k],
+                               cell_grey_[k],
+                               filled_[k]};
+        boundary = boundary || filled_[k] != filled_[i];
+      }
       if (!boundary || count == 0) {
         const std::uint8_t label = filled_[i];
         if (label == LABEL_NONE)
           continue;
-        for (int v = v0; v < v1; ++v)
-          for (int u = u0; u < u1; ++u) {
-            const std::size_t p = static_cast<std::size_t>(v) * width + u;
-            if (hasDepth(depth[p * stride]))
-              pixel_labels[p] = label;
-          }
+        for (int v = v0; v < v1; ++v) {
+          const std::size_t first = static_cast<std::size_t>(v) * width;
+          for (int u = u0; u < u1; ++u)
+            if (hasDepth(depth[(first + u) * stride]))
+              pixel_labels[first + u] = label;
+        }
         continue;
       }
       for (int v = v0; v < v1; ++v)
@@ -263,22 +276,21 @@ PixelLabelRefinement::refine(const FlowGrid& cells,
             continue;
           const float grey = rgba ? greyOf(rgba[p * stride]) : 0.0f;
           const float inv_z2 = inv_tol2 / (z * z);
+          const float fu = static_cast<float>(u), fv = static_cast<float>(v);
           float best = std::numeric_limits<float>::infinity();
           std::uint8_t label = LABEL_NONE;
           for (int n = 0; n < count; ++n) {
-            const std::size_t k = candidates[n];
-            const float du =
-                static_cast<float>(u - static_cast<int>(k % cols) * cell - cell / 2);
-            const float dv =
-                static_cast<float>(v - static_cast<int>(k / cols) * cell - cell / 2);
-            const float dz =
-                z - (cell_depth_[k] + gradient_u_[k] * du + gradient_v_[k] * dv);
-            const float dg = grey - cell_grey_[k];
-            const float cost = dz * dz * inv_z2 + (du * du + dv * dv) * inv_cell2 +
-                               colour_weight * dg * dg;
+            const Candidate& k = candidates[n];
+            const float du = fu - k.u, dv = fv - k.v;
+            const float distance = (du * du + dv * dv) * inv_cell2;
+            if (distance >= best) // the other terms only add to it
+              continue;
+            const float dz = z - (k.z + k.gradient_u * du + k.gradient_v * dv);
+            const float dg = grey - k.grey;
+            const float cost = distance + dz * dz * inv_z2 + colour_weight * dg * dg;
             if (cost < best) {
               best = cost;
-              label = filled_[k];
+              label = k.label;
             }
           }
           pixel_labels[p] = label;
