@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The whole odometry on synthetic sequences with known camera motion.
 #include <dynvo/app/odometry_pipeline.h>
+#include <dynvo/common/conventions.h>
 #include <dynvo/eval/trajectory_metrics.h>
 #include <dynvo/io/frame.h>
 #include <dynvo/io/tum_folder_source.h>
@@ -21,6 +22,16 @@ namespace {
 
 using Cloud = pcl::PointCloud<pcl::PointXYZRGB>;
 
+/// The synthesizer of the first `frames` frames of a scenario (default options otherwise).
+dynvo::SceneSynthesizer
+synthesizer(const std::string& scenario, int frames)
+{
+  dynvo::SynthOptions synth_options;
+  synth_options.scenario = scenario;
+  synth_options.frames = frames;
+  return dynvo::SceneSynthesizer(synth_options);
+}
+
 struct SequenceRun {
   dynvo::Trajectory estimate;
   dynvo::Trajectory groundtruth;
@@ -38,10 +49,7 @@ runScenario(const std::string& scenario,
             Edit edit,
             bool use_segmentation = true)
 {
-  dynvo::SynthOptions synth_options;
-  synth_options.scenario = scenario;
-  synth_options.frames = frames;
-  dynvo::SceneSynthesizer synth(synth_options);
+  const dynvo::SceneSynthesizer synth = synthesizer(scenario, frames);
   dynvo::app::PipelineOptions options;
   options.intrinsics = synth.intrinsics();
   options.threads = threads;
@@ -149,6 +157,34 @@ TEST(OdometryPipeline, ThreadCountDoesNotChangeTheResult)
         << "frame " << k;
 }
 
+TEST(OdometryPipeline, EveryPixelWithDepthIsLabelledFromTheFirstFrame)
+{
+  // docs/algorithm.md §6.1: label 0 only where the depth is missing; frame 0, without flow,
+  // is static background (the start-up assumption).
+  constexpr int FRAMES = 3;
+  const dynvo::SceneSynthesizer synth = synthesizer("static_two", FRAMES);
+  dynvo::app::PipelineOptions options;
+  options.intrinsics = synth.intrinsics();
+  dynvo::app::OdometryPipeline pipeline(options);
+  for (int k = 0; k < FRAMES; ++k) {
+    const dynvo::SynthFrame frame = synth.render(k);
+    const auto cloud =
+        dynvo::makeOrganizedCloud(frame.color, frame.depth, synth.intrinsics());
+    const dynvo::app::FrameResult& result = pipeline.process(cloud, frame.timestamp);
+    ASSERT_EQ(result.labels.size(), cloud->size());
+    std::size_t with_depth = 0, moving = 0;
+    for (std::size_t p = 0; p < cloud->size(); ++p) {
+      const bool has_depth = std::isfinite((*cloud)[p].z);
+      with_depth += has_depth;
+      moving += result.labels[p] >= 2;
+      ASSERT_EQ(result.labels[p] == dynvo::LABEL_NONE, !has_depth) << "frame " << k;
+    }
+    ASSERT_GT(with_depth, cloud->size() / 2) << "frame " << k;
+    if (k == 0)
+      EXPECT_EQ(moving, 0u);
+  }
+}
+
 TEST(OdometryPipeline, ReportsBadFramesAsLostWithoutThrowing)
 {
   dynvo::app::PipelineOptions options;
@@ -182,16 +218,14 @@ TEST(OdometryPipeline, ABadFrameLeavesTheRestOfTheRunUntouched)
 {
   // The bad frame keeps the sequence state, so every good frame is registered against the
   // same previous frame as in the run without it: the poses are the same bits.
-  dynvo::SynthOptions synth_options;
-  synth_options.scenario = "moving_crossing";
-  synth_options.frames = 8;
-  dynvo::SceneSynthesizer synth(synth_options);
+  constexpr int FRAMES = 8;
+  const dynvo::SceneSynthesizer synth = synthesizer("moving_crossing", FRAMES);
   dynvo::app::PipelineOptions options;
   options.intrinsics = synth.intrinsics();
   dynvo::app::OdometryPipeline clean(options);
   dynvo::app::OdometryPipeline interrupted(options);
   Eigen::Matrix4d last = Eigen::Matrix4d::Identity();
-  for (int k = 0; k < synth_options.frames; ++k) {
+  for (int k = 0; k < FRAMES; ++k) {
     const dynvo::SynthFrame frame = synth.render(k);
     const auto cloud =
         dynvo::makeOrganizedCloud(frame.color, frame.depth, synth.intrinsics());
@@ -224,7 +258,8 @@ TEST(OdometryPipeline, InlierThresholdFollowsTheMeasuredNoise)
   EXPECT_DOUBLE_EQ(run.inlier_threshold[1], defaults.segmentation.inlier_threshold);
   for (std::size_t k = 2; k < run.inlier_threshold.size(); ++k) {
     EXPECT_GE(run.inlier_threshold[k], defaults.inlier_noise.min_inlier_threshold) << k;
-    EXPECT_LT(run.inlier_threshold[k], 0.75 * defaults.segmentation.inlier_threshold) << k;
+    EXPECT_LT(run.inlier_threshold[k], 0.75 * defaults.segmentation.inlier_threshold)
+        << k;
   }
 }
 
