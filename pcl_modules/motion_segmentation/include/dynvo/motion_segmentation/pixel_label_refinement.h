@@ -14,15 +14,15 @@ namespace dynvo {
 /** \brief Turns the per-cell labels of the segmentation into one label per pixel with depth
  * (docs/algorithm.md §6.1).
  *
- * 1. Cell fill. A cell with at least one pixel with depth but label 0 (no valid track, or no
- *    measurement this frame) takes, in order: its fallback label (the compensated dual
- *    model's read-out, §5-§6) when non-zero; else the label of a 4-connected labelled cell
- *    whose reference depth is continuous with its own (relative difference at most
- *    depth_tolerance), spreading breadth-first from the labelled cells; else the label of the
- *    4-neighbour of closest reference depth, spreading the same way. A cell's reference
- *    depth is its centre pixel's, else the mean of its central 5x5 pixels with depth, else
- *    the mean of all its pixels with depth. Only a frame without any labelled cell leaves
- *    cells with depth at 0.
+ * 1. Cell fill. Cells with at least one pixel with depth but label 0 (no valid track, or no
+ *    measurement this frame) are filled breadth-first from the labelled cells: first through
+ *    4-neighbours whose reference depth is continuous (relative difference at most
+ *    depth_tolerance of the nearer); then a cell still without a label takes its fallback
+ *    label (the compensated dual model's read-out, §5-§6) when non-zero, and the continuous
+ *    spreading runs again; last, the rest take the label of their labelled 4-neighbour of
+ *    closest reference depth. A cell's reference depth is its centre pixel's, else the mean
+ *    of its central 5x5 pixels with depth, else the mean of all its pixels with depth. Only a
+ *    frame without any labelled cell leaves cells with depth at 0.
  * 2. Pixels. A cell whose 8 neighbours all carry its own label (or 0) gives that label to
  *    its pixels with depth. In a boundary cell (a neighbour with another label) each pixel
  *    with depth takes the label of the cell among its own and its 8 neighbours (labelled,
@@ -30,8 +30,9 @@ namespace dynvo {
  *    `((z - z_n(u, v)) / (depth_tolerance z))^2 + (distance to c_n / w_grid)^2 +
  *    colour_weight ((I - I_n) / 255)^2`, z_n(u, v) being cell n's reference depth
  *    extrapolated to the pixel with its depth gradient (from its continuous 4-neighbours of
- *    the same label) and I the pixel's and I_n cell n's centre grey level (mean of r, g, b): a depth discontinuity separates an
- *    object from what lies behind it, proximity decides on one continuous surface.
+ *    the same label), I the pixel's and I_n cell n's centre grey level (mean of r, g, b):
+ *    a depth discontinuity separates an object from what lies behind it, proximity decides
+ *    on one continuous surface.
  * 3. Pixels without depth get 0. Pixels right of or below the last full cell belong to the
  *    nearest cell.
  *
@@ -69,8 +70,9 @@ public:
 
   /** \brief Labels every pixel with depth.
    * \param[in] cells grid geometry and the output label of each cell (0 none)
-   * \param[in] fallback_labels per cell, the label a cell without one takes first (the
-   *            dual model's read-out); empty = none
+   * \param[in] fallback_labels per cell, the label a cell without one and without a
+   *            depth-continuous labelled neighbour takes (the dual model's read-out); empty =
+   *            none
    * \param[in] depth z of pixel 0 (metres; NaN or <= 0 = no depth); pixel i's z is
    *            depth[i * stride]
    * \param[in] rgba packed colour of pixel 0 (PCL's rgba: b, g, r, a bytes), pixel i's at
