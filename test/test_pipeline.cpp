@@ -32,6 +32,15 @@ synthesizer(const std::string& scenario, int frames)
   return dynvo::SceneSynthesizer(synth_options);
 }
 
+/// Default pipeline options with the synthesizer's camera.
+dynvo::app::PipelineOptions
+optionsFor(const dynvo::SceneSynthesizer& synth)
+{
+  dynvo::app::PipelineOptions options;
+  options.intrinsics = synth.intrinsics();
+  return options;
+}
+
 struct SequenceRun {
   dynvo::Trajectory estimate;
   dynvo::Trajectory groundtruth;
@@ -50,8 +59,7 @@ runScenario(const std::string& scenario,
             bool use_segmentation = true)
 {
   const dynvo::SceneSynthesizer synth = synthesizer(scenario, frames);
-  dynvo::app::PipelineOptions options;
-  options.intrinsics = synth.intrinsics();
+  dynvo::app::PipelineOptions options = optionsFor(synth);
   options.threads = threads;
   options.use_segmentation = use_segmentation;
   dynvo::app::OdometryPipeline pipeline(options);
@@ -163,8 +171,7 @@ TEST(OdometryPipeline, EveryPixelWithDepthIsLabelledFromTheFirstFrame)
   // is static background (the start-up assumption).
   constexpr int FRAMES = 3;
   const dynvo::SceneSynthesizer synth = synthesizer("static_two", FRAMES);
-  dynvo::app::PipelineOptions options;
-  options.intrinsics = synth.intrinsics();
+  dynvo::app::PipelineOptions options = optionsFor(synth);
   dynvo::app::OdometryPipeline pipeline(options);
   for (int k = 0; k < FRAMES; ++k) {
     const dynvo::SynthFrame frame = synth.render(k);
@@ -220,8 +227,7 @@ TEST(OdometryPipeline, ABadFrameLeavesTheRestOfTheRunUntouched)
   // same previous frame as in the run without it: the poses are the same bits.
   constexpr int FRAMES = 8;
   const dynvo::SceneSynthesizer synth = synthesizer("moving_crossing", FRAMES);
-  dynvo::app::PipelineOptions options;
-  options.intrinsics = synth.intrinsics();
+  dynvo::app::PipelineOptions options = optionsFor(synth);
   dynvo::app::OdometryPipeline clean(options);
   dynvo::app::OdometryPipeline interrupted(options);
   Eigen::Matrix4d last = Eigen::Matrix4d::Identity();
