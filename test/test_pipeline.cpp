@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The whole odometry on synthetic sequences with known camera motion.
 #include <dynvo/app/odometry_pipeline.h>
+#include <dynvo/common/conventions.h>
 #include <dynvo/eval/trajectory_metrics.h>
 #include <dynvo/io/frame.h>
 #include <dynvo/io/tum_folder_source.h>
@@ -23,6 +24,25 @@ namespace {
 
 using Cloud = pcl::PointCloud<pcl::PointXYZRGB>;
 
+/// The synthesizer of the first `frames` frames of a scenario (default options otherwise).
+dynvo::SceneSynthesizer
+synthesizer(const std::string& scenario, int frames)
+{
+  dynvo::SynthOptions synth_options;
+  synth_options.scenario = scenario;
+  synth_options.frames = frames;
+  return dynvo::SceneSynthesizer(synth_options);
+}
+
+/// Default pipeline options with the synthesizer's camera.
+dynvo::app::PipelineOptions
+optionsFor(const dynvo::SceneSynthesizer& synth)
+{
+  dynvo::app::PipelineOptions options;
+  options.intrinsics = synth.intrinsics();
+  return options;
+}
+
 struct SequenceRun {
   dynvo::Trajectory estimate;
   dynvo::Trajectory groundtruth;
@@ -44,9 +64,8 @@ runSequence(const dynvo::SynthOptions& synth_options,
             Edit edit,
             const Configure& configure = {})
 {
-  dynvo::SceneSynthesizer synth(synth_options);
-  dynvo::app::PipelineOptions options;
-  options.intrinsics = synth.intrinsics();
+  const dynvo::SceneSynthesizer synth(synth_options);
+  dynvo::app::PipelineOptions options = optionsFor(synth);
   options.threads = threads;
   if (configure)
     configure(options);
@@ -305,6 +324,33 @@ TEST(OdometryPipeline, ThreadCountDoesNotChangeTheResult)
         << "frame " << k;
 }
 
+TEST(OdometryPipeline, EveryPixelWithDepthIsLabelledFromTheFirstFrame)
+{
+  // docs/algorithm.md §6.1: label 0 only where the depth is missing; frame 0, without flow,
+  // is static background (the start-up assumption).
+  constexpr int FRAMES = 3;
+  const dynvo::SceneSynthesizer synth = synthesizer("static_two", FRAMES);
+  dynvo::app::PipelineOptions options = optionsFor(synth);
+  dynvo::app::OdometryPipeline pipeline(options);
+  for (int k = 0; k < FRAMES; ++k) {
+    const dynvo::SynthFrame frame = synth.render(k);
+    const auto cloud =
+        dynvo::makeOrganizedCloud(frame.color, frame.depth, synth.intrinsics());
+    const dynvo::app::FrameResult& result = pipeline.process(cloud, frame.timestamp);
+    ASSERT_EQ(result.labels.size(), cloud->size());
+    std::size_t with_depth = 0, moving = 0;
+    for (std::size_t p = 0; p < cloud->size(); ++p) {
+      const bool has_depth = std::isfinite((*cloud)[p].z);
+      with_depth += has_depth;
+      moving += result.labels[p] >= 2;
+      ASSERT_EQ(result.labels[p] == dynvo::LABEL_NONE, !has_depth) << "frame " << k;
+    }
+    ASSERT_GT(with_depth, cloud->size() / 2) << "frame " << k;
+    if (k == 0)
+      EXPECT_EQ(moving, 0u);
+  }
+}
+
 TEST(OdometryPipeline, ReportsBadFramesAsLostWithoutThrowing)
 {
   dynvo::app::PipelineOptions options;
@@ -338,16 +384,13 @@ TEST(OdometryPipeline, ABadFrameLeavesTheRestOfTheRunUntouched)
 {
   // The bad frame keeps the sequence state, so every good frame is registered against the
   // same previous frame as in the run without it: the poses are the same bits.
-  dynvo::SynthOptions synth_options;
-  synth_options.scenario = "moving_crossing";
-  synth_options.frames = 8;
-  dynvo::SceneSynthesizer synth(synth_options);
-  dynvo::app::PipelineOptions options;
-  options.intrinsics = synth.intrinsics();
+  constexpr int FRAMES = 8;
+  const dynvo::SceneSynthesizer synth = synthesizer("moving_crossing", FRAMES);
+  dynvo::app::PipelineOptions options = optionsFor(synth);
   dynvo::app::OdometryPipeline clean(options);
   dynvo::app::OdometryPipeline interrupted(options);
   Eigen::Matrix4d last = Eigen::Matrix4d::Identity();
-  for (int k = 0; k < synth_options.frames; ++k) {
+  for (int k = 0; k < FRAMES; ++k) {
     const dynvo::SynthFrame frame = synth.render(k);
     const auto cloud =
         dynvo::makeOrganizedCloud(frame.color, frame.depth, synth.intrinsics());

@@ -14,6 +14,7 @@
 #include <Eigen/SVD>
 
 #include <chrono>
+#include <cmath>
 #include <stdexcept>
 
 namespace dynvo::app {
@@ -269,6 +270,15 @@ OdometryPipeline::process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& clo
   }
   if (p.frames == 0) {
     p.flow_estimation.setInputCloud(cloud);
+    // No motion to segment yet: under the start-up assumption (docs/algorithm.md §4, §6.1)
+    // every pixel with depth is static background.
+    result.segments.assign(1, pcl::PointIndices());
+    result.segments[0].header = cloud->header;
+    for (std::size_t index = 0; index < cloud->size(); ++index)
+      if (std::isfinite((*cloud)[index].z))
+        result.segments[0].indices.push_back(static_cast<int>(index));
+    result.segment_labels.assign(1, LABEL_STATIC);
+    result.motions.assign(1, Eigen::Matrix4f::Identity());
   }
   else {
     p.track(cloud);

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Per-frame cost of the rigid motion segmentation stages at VGA (1200 cells, h_max 20).
 #include <dynvo/io/frame.h>
+#include <dynvo/motion_segmentation/pixel_label_refinement.h>
 #include <dynvo/motion_segmentation/rigid_motion_segmentation.h>
 #include <dynvo/scene_flow/grid_scene_flow_estimation.h>
 #include <dynvo/synth/scene_synthesizer.h>
@@ -146,6 +147,41 @@ BM_SegmentTracking(benchmark::State& state)
   }
 }
 BENCHMARK(BM_SegmentTracking)
+    ->ArgName("noise")
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+/// §6.1 alone: cell labels to pixel labels (fill and per-pixel boundaries) on the tracked
+/// output of segment() for each frame (computed beforehand). Arg: noise.
+void
+BM_PixelLabelRefinement(benchmark::State& state)
+{
+  const std::vector<FlowFrame>& frames = sequence(state.range(0) == 1);
+  dynvo::RigidMotionSegmentation<Point> segmentation;
+  std::vector<dynvo::FlowGrid> cells(frames.size());
+  std::vector<std::vector<std::uint8_t>> model(frames.size());
+  std::vector<pcl::PointIndices> segments;
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    segmentation.setInputCloud(frames[k].cloud);
+    segmentation.setInputFlow(frames[k].flow);
+    segmentation.segment(segments);
+    cells[k] = segmentation.getCellGrid();
+    model[k] = segmentation.getTracker().modelLabels();
+  }
+  const std::size_t stride = sizeof(Point) / sizeof(float);
+  dynvo::PixelLabelRefinement refinement;
+  std::vector<std::uint8_t> pixels;
+  std::size_t k = 0;
+  for (auto _ : state) {
+    const std::size_t f = k++ % frames.size();
+    const pcl::PointCloud<Point>& cloud = *frames[f].cloud;
+    refinement.refine(cells[f], model[f], &cloud[0].z, &cloud[0].rgba, stride, pixels);
+    benchmark::DoNotOptimize(pixels.data());
+  }
+}
+BENCHMARK(BM_PixelLabelRefinement)
     ->ArgName("noise")
     ->Arg(0)
     ->Arg(1)

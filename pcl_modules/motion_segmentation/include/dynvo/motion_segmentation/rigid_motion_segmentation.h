@@ -8,12 +8,14 @@
 #include <dynvo/common/flow_grid.h>
 #include <dynvo/common/point_types.h>
 #include <dynvo/motion_segmentation/grid_flow_data.h>
+#include <dynvo/motion_segmentation/pixel_label_refinement.h>
 #include <dynvo/motion_segmentation/rigid_motion_segmentation_parameters.h>
 #include <dynvo/motion_segmentation/segment_tracker.h>
 #include <dynvo/motion_segmentation/spatial_segmentation.h>
 
 #include <pcl/PointIndices.h>
 #include <pcl/pcl_base.h>
+#include <pcl/point_types.h> // pcl::Label
 #include <pcl/point_cloud.h>
 
 #include <Eigen/Core>
@@ -39,7 +41,10 @@ namespace dynvo {
  * Output of segment(): element 0 is always the static background (label 1, possibly empty),
  * then one pcl::PointIndices per moving object in increasing id order; getSegmentLabels()
  * gives the ids and getMotions() one T_curr_prev per segment. Indices are linear pixel indices
- * (row * width + col) of every pixel with finite depth in the cells of the segment.
+ * (row * width + col); every pixel with finite depth belongs to exactly one segment, at
+ * pixel accuracy (PixelLabelRefinement, docs/algorithm.md §6.1: cells without a label are
+ * filled from the dual model or their depth-continuous neighbours, boundary cells are split
+ * pixel by pixel), unless no cell of the frame has a label.
  * With tracking off, the segments are the two-frame ones, largest first (its label 1).
  * \code
  * dynvo::RigidMotionSegmentation<pcl::PointXYZRGB> segmentation;
@@ -91,6 +96,27 @@ public:
    *         fails, e.g. max_trials < max_hypotheses after the per-field setters
    */
   void segment(std::vector<pcl::PointIndices>& segments);
+
+  /** \brief As segment(segments), and the same pixel labels as an image.
+   * \param[out] segments as segment(segments)
+   * \param[out] labels organized like the input cloud: 0 no depth (or no labelled cell), 1
+   *             static, 2.. objects; empty when the inputs break the contract
+   */
+  void segment(std::vector<pcl::PointIndices>& segments,
+               pcl::PointCloud<pcl::Label>& labels);
+
+  /// Label of every pixel of the last segment() (row * width + col; 0 no depth), after
+  /// PixelLabelRefinement; empty when the inputs broke the contract.
+  const std::vector<std::uint8_t>& getPixelLabels() const { return pixel_labels_; }
+
+  /// The cell-to-pixel step (its parameters: setPixelRefinementParameters()).
+  const PixelLabelRefinement& getPixelRefinement() const { return refinement_; }
+
+  /// Parameters of the cell-to-pixel step. \throws std::invalid_argument when invalid
+  void setPixelRefinementParameters(const PixelLabelRefinement::Parameters& parameters)
+  {
+    refinement_.setParameters(parameters);
+  }
 
   /// Label id of each segment of the last segment() (element 0 is 1).
   const std::vector<std::uint8_t>& getSegmentLabels() const { return segment_labels_; }
@@ -191,7 +217,10 @@ protected:
   /// (FlowGrid::fromFlow()); sets the geometry of cell_grid_, logs PCL_ERROR otherwise.
   bool validateInputs();
 
-  /// Fills segments with the pixels of each labelled cell, in segment_labels_ order.
+  /// Pixel labels from the cell labels (PixelLabelRefinement), into pixel_labels_.
+  void computeImplPixelLabels();
+
+  /// Fills segments with the pixels of each label of pixel_labels_, in segment_labels_ order.
   void computeImplIndices(std::vector<pcl::PointIndices>& segments) const;
 
 private:
@@ -224,6 +253,8 @@ private:
   FlowGrid cell_grid_;                       ///< geometry and output label per cell
   std::vector<std::uint8_t> segment_labels_; ///< id of each output segment
   Motions motions_;                          ///< T_curr_prev of each output segment
+  PixelLabelRefinement refinement_;          ///< cell labels to pixel labels
+  std::vector<std::uint8_t> pixel_labels_;   ///< label per pixel of the last segment()
   /// s_axial, s_lateral: the sensor model's gains on its axial and lateral sigma, fitted
   /// over the frames
   std::array<float, 2> noise_gains_{1.0f, 1.0f};

@@ -5,6 +5,7 @@
 #include <dynvo/motion_segmentation/rigid_motion_segmentation.h>
 
 #include <pcl/console/print.h>
+#include <pcl/point_types.h>
 
 #include <algorithm>
 #include <array>
@@ -82,6 +83,7 @@ RigidMotionSegmentation<PointT>::clearOutputs()
   segment_labels_.clear();
   motions_.clear();
   spatial_ = SpatialSegmentationResult();
+  pixel_labels_.clear();
 }
 
 template <typename PointT>
@@ -118,6 +120,30 @@ RigidMotionSegmentation<PointT>::validateInputs()
 
 template <typename PointT>
 void
+RigidMotionSegmentation<PointT>::computeImplPixelLabels()
+{
+  // Fallback of a cell without a label: the dual model's read-out when it is an output id.
+  std::vector<std::uint8_t> fallback;
+  if (params_.tracking) {
+    std::array<bool, 256> output{};
+    for (const std::uint8_t id : segment_labels_)
+      output[id] = true;
+    fallback = tracker_.modelLabels();
+    for (std::uint8_t& label : fallback)
+      label = output[label] ? label : LABEL_NONE;
+  }
+  static_assert(sizeof(PointT) % sizeof(float) == 0,
+                "point fields must be 4-byte words");
+  const std::size_t stride = sizeof(PointT) / sizeof(float);
+  const std::uint32_t* rgba = nullptr;
+  if constexpr (pcl::traits::has_color<PointT>::value)
+    rgba = &(*input_)[0].rgba;
+  refinement_.refine(cell_grid_, fallback, &(*input_)[0].z, rgba, stride,
+                     pixel_labels_);
+}
+
+template <typename PointT>
+void
 RigidMotionSegmentation<PointT>::computeImplIndices(
     std::vector<pcl::PointIndices>& segments) const
 {
@@ -126,47 +152,30 @@ RigidMotionSegmentation<PointT>::computeImplIndices(
   slot.fill(-1);
   for (std::size_t s = 0; s < segment_labels_.size(); ++s)
     slot[segment_labels_[s]] = static_cast<int>(s);
-  const int cell = static_cast<int>(cell_grid_.cell_size);
   const int width = static_cast<int>(input_->width);
-  const int cols = static_cast<int>(flow_->width);
-  const int rows = static_cast<int>(flow_->height);
-  // Stripes of cell rows on their own threads, concatenated in order: the same indices for
-  // any thread count. Plain threads, not OpenMP: libgomp's spinning join costs more than
-  // this whole loop when other processes share the cores.
-  const int stripes = std::min<int>(static_cast<int>(threads_), rows);
+  const int height = static_cast<int>(input_->height);
+  // Stripes of pixel rows on their own threads, concatenated in order: the same indices
+  // for any thread count. Plain threads, not OpenMP: libgomp's spinning join costs more
+  // than this whole loop when other processes share the cores.
+  const int stripes = std::max(1, std::min<int>(static_cast<int>(threads_), height));
   std::vector<std::vector<std::vector<int>>> parts(
       stripes, std::vector<std::vector<int>>(segment_labels_.size()));
   const auto extract = [&](int stripe) {
     std::vector<std::vector<int>>& out = parts[stripe];
-    const int first_row = rows * stripe / stripes,
-              end_row = rows * (stripe + 1) / stripes;
-    // Room for every pixel of the stripe's cells, so the loop writes without branching.
+    const int first = height * stripe / stripes, end = height * (stripe + 1) / stripes;
     std::vector<std::size_t> size(out.size(), 0);
-    for (int r = first_row; r < end_row; ++r)
-      for (int c = 0; c < cols; ++c) {
-        const int s = slot[cell_grid_.labels[static_cast<std::size_t>(r) * cols + c]];
-        if (s >= 0)
-          size[s] += static_cast<std::size_t>(cell) * cell;
-      }
+    for (int index = first * width; index < end * width; ++index) {
+      const int s = slot[pixel_labels_[index]];
+      if (s >= 0)
+        ++size[s];
+    }
     for (std::size_t s = 0; s < out.size(); ++s)
-      out[s].resize(size[s]);
-    std::fill(size.begin(), size.end(), 0);
-    for (int r = first_row; r < end_row; ++r)
-      for (int v = r * cell; v < (r + 1) * cell; ++v)
-        for (int c = 0; c < cols; ++c) {
-          const int s = slot[cell_grid_.labels[static_cast<std::size_t>(r) * cols + c]];
-          if (s < 0)
-            continue;
-          int* write = out[s].data();
-          std::size_t& n = size[s];
-          const int begin = v * width + c * cell;
-          for (int index = begin; index < begin + cell; ++index) {
-            write[n] = index;
-            n += std::isfinite((*input_)[index].z) ? 1 : 0;
-          }
-        }
-    for (std::size_t s = 0; s < out.size(); ++s)
-      out[s].resize(size[s]);
+      out[s].reserve(size[s]);
+    for (int index = first * width; index < end * width; ++index) {
+      const int s = slot[pixel_labels_[index]];
+      if (s >= 0)
+        out[s].push_back(index);
+    }
   };
   std::vector<std::thread> workers;
   for (int stripe = 1; stripe < stripes; ++stripe)
@@ -224,7 +233,24 @@ RigidMotionSegmentation<PointT>::segment(std::vector<pcl::PointIndices>& segment
     }
   }
   updateNoiseScale();
+  computeImplPixelLabels();
   computeImplIndices(segments);
+}
+
+template <typename PointT>
+void
+RigidMotionSegmentation<PointT>::segment(std::vector<pcl::PointIndices>& segments,
+                                         pcl::PointCloud<pcl::Label>& labels)
+{
+  labels.clear();
+  segment(segments);
+  if (pixel_labels_.empty())
+    return;
+  labels.header = input_->header;
+  labels.resize(input_->width, input_->height);
+  labels.is_dense = true;
+  for (std::size_t index = 0; index < pixel_labels_.size(); ++index)
+    labels[index].label = pixel_labels_[index];
 }
 
 template <typename PointT>
