@@ -23,7 +23,8 @@ isUsable(const RgbdImage& image)
 {
   const std::size_t n = image.width * image.height;
   return n > 0 && image.gray.size() == n && image.depth.size() == n &&
-         image.mask.size() == n && cv::countNonZero(view(image, image.mask, CV_8UC1)) > 0;
+         image.mask.size() == n &&
+         cv::countNonZero(view(image, image.mask, CV_8UC1)) > 0;
 }
 
 } // namespace
@@ -55,7 +56,8 @@ estimateRgbdOdometry(const RgbdImage& source,
   const bool ok = odometry.compute(
       view(source, source.gray, CV_8UC1), view(source, source.depth, CV_32FC1),
       view(source, source.mask, CV_8UC1), view(target, target.gray, CV_8UC1),
-      view(target, target.depth, CV_32FC1), view(target, target.mask, CV_8UC1), Rt, init);
+      view(target, target.depth, CV_32FC1), view(target, target.mask, CV_8UC1), Rt,
+      init);
   if (!ok || Rt.rows != 4 || Rt.cols != 4)
     return false;
   for (int r = 0; r < 4; ++r)

@@ -38,14 +38,17 @@ largeObjectScene()
 /// segmentation that labels the object exactly).
 template <typename PointT>
 dynvo::FlowGrid
-staticCellsOf(const RenderedView<PointT>& view, const BoxScene& scene, const dynvo::FlowGrid& grid)
+staticCellsOf(const RenderedView<PointT>& view,
+              const BoxScene& scene,
+              const dynvo::FlowGrid& grid)
 {
   dynvo::FlowGrid cells = grid;
   for (std::size_t i = 0; i < cells.size(); ++i) {
     bool moving = false;
     grid.forEachPixel(i, [&](std::size_t index) {
       const int box = view.ids[index];
-      moving = moving || (box >= 0 && scene.boxes[static_cast<std::size_t>(box)].moving);
+      moving =
+          moving || (box >= 0 && scene.boxes[static_cast<std::size_t>(box)].moving);
     });
     cells.labels[i] = moving ? dynvo::LABEL_NONE : dynvo::LABEL_STATIC;
   }
@@ -224,7 +227,8 @@ TEST(StaticMaskRegistrationParameters, BadValuesThrowAndKeepTheOldValue)
   EXPECT_THROW(backend.setCameraIntrinsics(bad_camera), std::invalid_argument);
 }
 
-template <typename PointT> class StaticMaskRegistrationTyped : public ::testing::Test {};
+template <typename PointT> class StaticMaskRegistrationTyped : public ::testing::Test {
+};
 using PointTypes = ::testing::Types<pcl::PointXYZRGB, pcl::PointXYZRGBA>;
 TYPED_TEST_SUITE(StaticMaskRegistrationTyped, PointTypes);
 

@@ -17,11 +17,11 @@ namespace dynvo::detail {
 
 /// One RGB-D frame for cv::rgbd::RgbdOdometry, row-major, width x height each.
 struct DYNVO_EXPORTS RgbdImage {
-  std::size_t width = 0;            ///< columns (px)
-  std::size_t height = 0;           ///< rows (px)
-  std::vector<std::uint8_t> gray;   ///< intensity 0..255
-  std::vector<float> depth;         ///< z (metres), NaN where none
-  std::vector<std::uint8_t> mask;   ///< 255 where the pixel may be used, 0 elsewhere
+  std::size_t width = 0;          ///< columns (px)
+  std::size_t height = 0;         ///< rows (px)
+  std::vector<std::uint8_t> gray; ///< intensity 0..255
+  std::vector<float> depth;       ///< z (metres), NaN where none
+  std::vector<std::uint8_t> mask; ///< 255 where the pixel may be used, 0 elsewhere
 };
 
 /** \brief cv::rgbd::RgbdOdometry (photometric, four pyramid levels, OpenCV's iteration counts

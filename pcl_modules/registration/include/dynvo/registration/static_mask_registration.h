@@ -18,9 +18,9 @@ namespace dynvo {
 
 /// What the last align() of StaticMaskRegistration produced.
 enum class StaticMaskRegistrationStatus {
-  not_computed,  ///< align() has not run yet
-  flow,          ///< the backend is flow: the guess is the result
-  invalid_input, ///< the inputs broke the contract (logged with PCL_ERROR): the guess
+  not_computed,   ///< align() has not run yet
+  flow,           ///< the backend is flow: the guess is the result
+  invalid_input,  ///< the inputs broke the contract (logged with PCL_ERROR): the guess
   too_few_points, ///< fewer than MIN_POINTS usable masked points: the guess
   not_converged,  ///< the backend did not converge: the guess
   converged       ///< the backend's estimate is the result
@@ -127,11 +127,14 @@ private:
   /// Non-null organized clouds of equal size, masks on grids over them; logs PCL_ERROR.
   bool validateInputs() const;
 
-  /// ICP/GICP on the masked lattice points; status_ set.
-  bool alignPoints(const Eigen::Matrix4f& guess, Eigen::Matrix4f& T_prev_curr);
+  /// True when both counts reach MIN_POINTS; logs PCL_DEBUG otherwise.
+  bool enoughPoints(std::size_t source_count, std::size_t target_count) const;
 
-  /// cv::rgbd::RgbdOdometry on the masked images; status_ set.
-  bool alignImages(const Eigen::Matrix4f& guess, Eigen::Matrix4f& T_prev_curr);
+  /// ICP/GICP on the masked lattice points; T_prev_curr written when converged.
+  Status alignPoints(const Eigen::Matrix4f& guess, Eigen::Matrix4f& T_prev_curr);
+
+  /// cv::rgbd::RgbdOdometry on the masked images; T_prev_curr written when converged.
+  Status alignImages(const Eigen::Matrix4f& guess, Eigen::Matrix4f& T_prev_curr);
 
   std::string class_name_ = "StaticMaskRegistration"; ///< log prefix
   Parameters params_;                                 ///< validated knobs

@@ -11,8 +11,8 @@ namespace dynvo {
 enum class RegistrationBackend {
   flow,    ///< the trimmed flow-correspondence fit is the result (the paper's method)
   cv_rgbd, ///< OpenCV's dense RGB-D odometry (cv::rgbd::RgbdOdometry) on the static pixels
-  icp,  ///< pcl::IterativeClosestPoint (point-to-point) on the static points
-  gicp  ///< pcl::GeneralizedIterativeClosestPoint (plane-to-plane) on the static points
+  icp,     ///< pcl::IterativeClosestPoint (point-to-point) on the static points
+  gicp ///< pcl::GeneralizedIterativeClosestPoint (plane-to-plane) on the static points
 };
 
 /** \brief Parameters of StaticMaskRegistration (the single source of the defaults).
@@ -31,7 +31,8 @@ struct DYNVO_EXPORTS StaticMaskRegistrationParameters {
       4; ///< (px, >= 1): ICP/GICP use every stride-th row and column of both masks (19,200 points at VGA)
   float rgbd_max_depth_difference =
       0.07f; ///< (metres, > 0): cv_rgbd drops pixel pairs whose depths differ more (OpenCV's default)
-  float rgbd_max_depth = 4.0f; ///< (metres, > 0): cv_rgbd ignores farther pixels (OpenCV's default)
+  float rgbd_max_depth =
+      4.0f; ///< (metres, > 0): cv_rgbd ignores farther pixels (OpenCV's default)
 
   /// Names, units and ranges of the fields above, in file order (ParameterTable).
   static const ParameterTable<StaticMaskRegistrationParameters>& table();

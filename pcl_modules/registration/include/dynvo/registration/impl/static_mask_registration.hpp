@@ -26,7 +26,9 @@ staticPixelMask(const FlowGrid& cells)
       static_cast<std::size_t>(cells.image_width) * cells.image_height, 0);
   for (std::size_t i = 0; i < cells.size(); ++i)
     if (cells.labels[i] == LABEL_STATIC)
-      cells.forEachPixel(i, [&mask](std::size_t index) { mask[index] = 255; });
+      cells.forEachPixel(i, [&mask](std::size_t index) {
+        mask[index] = 255;
+      });
   return mask;
 }
 
@@ -90,12 +92,25 @@ StaticMaskRegistration<PointT>::validateInputs() const
            cells.image_height == source_->height && cells.labels.size() == cells.size();
   };
   if (!covers(source_cells_) || !covers(target_cells_))
-    return fail("the static cells of both frames must be grids over the clouds' images");
+    return fail(
+        "the static cells of both frames must be grids over the clouds' images");
   return true;
 }
 
 template <typename PointT>
 bool
+StaticMaskRegistration<PointT>::enoughPoints(std::size_t source_count,
+                                             std::size_t target_count) const
+{
+  if (source_count >= MIN_POINTS && target_count >= MIN_POINTS)
+    return true;
+  PCL_DEBUG("[dynvo::%s::align] %zu source / %zu target masked points.\n",
+            class_name_.c_str(), source_count, target_count);
+  return false;
+}
+
+template <typename PointT>
+StaticMaskRegistrationStatus
 StaticMaskRegistration<PointT>::alignPoints(const Eigen::Matrix4f& guess,
                                             Eigen::Matrix4f& T_prev_curr)
 {
@@ -104,20 +119,15 @@ StaticMaskRegistration<PointT>::alignPoints(const Eigen::Matrix4f& guess,
       *source_, detail::staticPixelMask(source_cells_), stride);
   const auto target = detail::maskedLatticePoints(
       *target_, detail::staticPixelMask(target_cells_), stride);
-  if (source->size() < MIN_POINTS || target->size() < MIN_POINTS) {
-    PCL_DEBUG("[dynvo::%s::align] %zu source / %zu target masked points.\n",
-              class_name_.c_str(), source->size(), target->size());
-    status_ = Status::too_few_points;
-    return false;
-  }
-  const bool ok =
-      detail::refineRigidTransformation(source, target, params_, guess, T_prev_curr);
-  status_ = ok ? Status::converged : Status::not_converged;
-  return ok;
+  if (!enoughPoints(source->size(), target->size()))
+    return Status::too_few_points;
+  return detail::refineRigidTransformation(source, target, params_, guess, T_prev_curr)
+             ? Status::converged
+             : Status::not_converged;
 }
 
 template <typename PointT>
-bool
+StaticMaskRegistrationStatus
 StaticMaskRegistration<PointT>::alignImages(const Eigen::Matrix4f& guess,
                                             Eigen::Matrix4f& T_prev_curr)
 {
@@ -129,14 +139,12 @@ StaticMaskRegistration<PointT>::alignImages(const Eigen::Matrix4f& guess,
     return static_cast<std::size_t>(
         std::count(image.mask.begin(), image.mask.end(), std::uint8_t{255}));
   };
-  if (masked(source) < MIN_POINTS || masked(target) < MIN_POINTS) {
-    status_ = Status::too_few_points;
-    return false;
-  }
-  const bool ok = detail::estimateRgbdOdometry(source, target, intrinsics_, params_,
-                                               guess, T_prev_curr);
-  status_ = ok ? Status::converged : Status::not_converged;
-  return ok;
+  if (!enoughPoints(masked(source), masked(target)))
+    return Status::too_few_points;
+  return detail::estimateRgbdOdometry(source, target, intrinsics_, params_, guess,
+                                      T_prev_curr)
+             ? Status::converged
+             : Status::not_converged;
 }
 
 template <typename PointT>
@@ -154,12 +162,12 @@ StaticMaskRegistration<PointT>::align(const Eigen::Matrix4f& guess,
     return false;
   }
   Eigen::Matrix4f estimate = guess;
-  const bool ok = params_.backend == RegistrationBackend::cv_rgbd
-                      ? alignImages(guess, estimate)
-                      : alignPoints(guess, estimate);
-  if (ok)
+  status_ = params_.backend == RegistrationBackend::cv_rgbd
+                ? alignImages(guess, estimate)
+                : alignPoints(guess, estimate);
+  if (status_ == Status::converged)
     T_prev_curr = estimate;
-  return ok;
+  return status_ == Status::converged;
 }
 
 } // namespace dynvo
