@@ -66,10 +66,10 @@ parameterFlags()
        "",
        "ablation: every valid flow cell counts as static, no object labels",
        S::all},
-      {"refine",
-       "registration.refinement",
+      {"backend",
+       "registration.backend",
        "",
-       "refinement of the static registration",
+       "ego-motion method on the static mask, from the flow estimate",
        S::all},
   };
   return flags;
@@ -87,7 +87,7 @@ fieldOf(const ParameterFlag& flag)
   return pipelineConfigTable().field(flag.key);
 }
 
-/// "none|icp|gicp" for a choice, else the flag's own value name.
+/// "flow|cv_rgbd|icp|gicp" for a choice, else the flag's own value name.
 std::string
 valueName(const ParameterFlag& flag)
 {

@@ -7,6 +7,7 @@
 #include <dynvo/common/parameter_table.h>
 #include <dynvo/motion_segmentation/rigid_motion_segmentation_parameters.h>
 #include <dynvo/registration/inlier_noise_tracker.h>
+#include <dynvo/registration/static_mask_registration_parameters.h>
 #include <dynvo/registration/static_scene_registration_parameters.h>
 #include <dynvo/registration/static_set_selection_parameters.h>
 #include <dynvo/scene_flow/grid_scene_flow_parameters.h>
@@ -39,6 +40,9 @@ struct DYNVO_EXPORTS PipelineOptions {
   RigidMotionSegmentationParameters
       segmentation; ///< docs/algorithm.md §3-§6 (seed included)
   StaticSceneRegistrationParameters registration; ///< docs/algorithm.md §7
+  /// The ego-motion method on the static mask, from the flow estimate (StaticMaskRegistration;
+  /// YAML registration.backend, registration.icp_*, registration.rgbd_*).
+  StaticMaskRegistrationParameters backend;
   bool use_segmentation =
       true; ///< false: ablation, every valid flow cell counts as static
   /// Static consensus and motion guard (StaticSetSelection; YAML pipeline.static_consensus);
