@@ -6,7 +6,7 @@ ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="${DYNVO_BUILD_DIR:-$ROOT/build}"
 
 # Debian 12 packages dynvo needs (see README.md).
-PACKAGES=(cmake ninja-build g++ libpcl-dev pcl-tools libopencv-dev libvtk9-dev
+PACKAGES=(cmake ninja-build g++ libpcl-dev pcl-tools libopencv-dev libopencv-contrib-dev libvtk9-dev
           libeigen3-dev libflann-dev libgtest-dev libbenchmark-dev libopenni2-dev
           libopenni-dev xvfb xauth clang)
 

@@ -319,7 +319,11 @@ TEST_F(OdometryApp, ObjectTrajectoriesFollowTheMotionsOfTheObjectsFile)
 TEST_F(OdometryApp, BadFlagsAndMissingInput)
 {
   EXPECT_EQ(runCommand(run("-bogus")).exit_code, 2);
-  EXPECT_EQ(runCommand(run("-refine lm")).exit_code, 2);
+  const auto backend = runCommand(run("-backend lm"));
+  EXPECT_EQ(backend.exit_code, 2);
+  EXPECT_NE(backend.err.find("-backend must be flow|cv_rgbd|icp|gicp, got 'lm'"),
+            std::string::npos)
+      << backend.err;
   EXPECT_EQ(runCommand(run("-threads 0")).exit_code, 2);
   const auto every =
       runCommand(run("-clouds_dir " + out_.file("c") + " -clouds_every 0"));

@@ -109,7 +109,7 @@ TEST_F(PipelineApps, SegmentWritesTheLabelsOfOdometryWithFlagsAndConfig)
   changed.inlier_noise.inlier_noise_factor = 0.0f;
   dynvo::app::writePipelineConfig(dir_.file("c.yaml"), changed);
   expectSameLabels("-config " + dir_.file("c.yaml") +
-                   " -seed 7 -threads 2 -no_tracking -refine icp -max_frames 12");
+                   " -seed 7 -threads 2 -no_tracking -backend icp -max_frames 12");
 }
 
 TEST_F(PipelineApps, ConfigMeansTheSameInEveryApp)
@@ -167,7 +167,7 @@ TEST_F(PipelineApps, SharedFlagsHaveOneHelpLineAndDefault)
     EXPECT_EQ(segment.at(flag), odometry.at(flag));
     EXPECT_EQ(scene_flow.at(flag), odometry.at(flag));
   }
-  for (const char* flag : {"-seed", "-no_tracking", "-no_segmentation", "-refine",
+  for (const char* flag : {"-seed", "-no_tracking", "-no_segmentation", "-backend",
                            "-max_frames", "-objects"}) {
     ASSERT_EQ(odometry.count(flag), 1u) << flag;
     EXPECT_EQ(segment.at(flag), odometry.at(flag));
@@ -197,7 +197,7 @@ TEST(PipelineFlags, EachFlagSetsItsKeysAndNothingElse)
   const auto given = optionsOf({"-threads", "4", "-cell_size", "8", "-window_size",
                                 "15", "-max_pyramid_level", "2", "-fb_check", "local",
                                 "-seed", "9", "-no_tracking", "-no_segmentation",
-                                "-refine", "gicp", "-camera", "fr1"});
+                                "-backend", "gicp", "-camera", "fr1"});
   EXPECT_EQ(given.threads, 4u);
   EXPECT_EQ(given.scene_flow.cell_size, 8);
   EXPECT_EQ(given.scene_flow.window_size, 15);
@@ -207,7 +207,7 @@ TEST(PipelineFlags, EachFlagSetsItsKeysAndNothingElse)
   EXPECT_EQ(given.segmentation.seed, 9u);
   EXPECT_FALSE(given.segmentation.tracking);
   EXPECT_FALSE(given.use_segmentation);
-  EXPECT_EQ(given.registration.refinement, dynvo::RegistrationRefinement::gicp);
+  EXPECT_EQ(given.backend.backend, dynvo::RegistrationBackend::gicp);
   EXPECT_FLOAT_EQ(given.intrinsics.fx, dynvo::CameraIntrinsics::fromPreset("fr1").fx);
 }
 
@@ -228,7 +228,8 @@ TEST(PipelineFlags, ValuesOutOfRangeAreUsageErrors)
   EXPECT_EQ(message({"-cell_size", "1"}), "-cell_size must be >= 2, got 1");
   EXPECT_EQ(message({"-cell_size", "3000000000"}),
             "-cell_size must be a whole number >= 2, got 3e+09");
-  EXPECT_EQ(message({"-refine", "lm"}), "-refine must be none|icp|gicp, got 'lm'");
+  EXPECT_EQ(message({"-backend", "lm"}),
+            "-backend must be flow|cv_rgbd|icp|gicp, got 'lm'");
   EXPECT_EQ(message({"-window_size", "x"}),
             "option '-window_size' expects an integer, got 'x'");
 }

@@ -4,6 +4,7 @@
 #include <dynvo/io/label_io.h>
 #include <dynvo/motion_segmentation/rigid_motion_segmentation.h>
 #include <dynvo/registration/inlier_noise_tracker.h>
+#include <dynvo/registration/static_mask_registration.h>
 #include <dynvo/registration/static_scene_registration.h>
 #include <dynvo/registration/static_set_selection.h>
 #include <dynvo/scene_flow/grid_scene_flow_estimation.h>
@@ -60,6 +61,7 @@ PipelineOptions::validate() const
   scene_flow.validate();
   segmentation.validate();
   registration.validate();
+  backend.validate();
   static_set.validate();
   inlier_noise.validate();
   table().checkAll(*this, "[dynvo::app::PipelineOptions]");
@@ -86,6 +88,8 @@ struct OdometryPipeline::Impl {
     selection.setMotionGuardTolerance(options.segmentation.static_guard_tolerance);
     noise_tracker.setParameters(options.inlier_noise);
     noise_tracker.setUpperBound(options.segmentation.inlier_threshold);
+    backend.setParameters(options.backend);
+    backend.setCameraIntrinsics(options.intrinsics);
   }
 
   /// Why the frame cannot be processed, or empty when it can.
@@ -140,6 +144,7 @@ struct OdometryPipeline::Impl {
         result.lost
             ? T_curr_prev_predicted
             : rigidInverse(registration.getFinalTransformation().cast<double>());
+    alignOnStaticMask(cloud);
     result.times.registration_ms = millisecondsSince(registration_start);
   }
 
@@ -216,6 +221,25 @@ struct OdometryPipeline::Impl {
     result.times.registration_ms += millisecondsSince(registration_start);
   }
 
+  /// The backend (options.backend) from the flow estimate, on the static cells of this frame
+  /// and of the previous one (this frame's for the first pair, whose first frame is not
+  /// labelled); the flow backend keeps the flow estimate.
+  void alignOnStaticMask(const Cloud::ConstPtr& cloud)
+  {
+    const FlowGrid& static_cells = selection.getStaticCells();
+    if (!result.lost && options.backend.backend != RegistrationBackend::flow) {
+      backend.setInputSource(cloud);
+      backend.setInputTarget(previous);
+      backend.setSourceStaticCells(static_cells);
+      backend.setTargetStaticCells(
+          previous_static_cells.size() > 0 ? previous_static_cells : static_cells);
+      Eigen::Matrix4f T_prev_curr;
+      backend.align(registration.getFinalTransformation(), T_prev_curr);
+      result.T_curr_prev = rigidInverse(T_prev_curr.cast<double>());
+    }
+    previous_static_cells = static_cells;
+  }
+
   PipelineOptions options;
   GridSceneFlowEstimation<pcl::PointXYZRGB> flow_estimation;
   RigidMotionSegmentation<pcl::PointXYZRGB> segmentation;
@@ -228,6 +252,9 @@ struct OdometryPipeline::Impl {
   std::size_t keyframe_inliers = 0;  ///< inliers of the first fit to the keyframe
   StaticSetSelection<pcl::PointXYZRGB> selection;
   InlierNoiseTracker noise_tracker;
+  StaticMaskRegistration<pcl::PointXYZRGB> backend;
+  FlowGrid
+      previous_static_cells; ///< the static set of the previous frame (the backend's)
   Cloud::ConstPtr previous;
   Eigen::Matrix4d T_world_prev = Eigen::Matrix4d::Identity();
   Eigen::Matrix4d T_curr_prev_predicted = Eigen::Matrix4d::Identity();
@@ -283,7 +310,8 @@ OdometryPipeline::process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& clo
   else {
     p.track(cloud);
     result.T_world_curr = p.T_world_prev * rigidInverse(result.T_curr_prev);
-    if (p.options.keyframes) {
+    // The keyframe fit is the flow backend's; the other backends run frame to frame.
+    if (p.options.keyframes && p.options.backend.backend == RegistrationBackend::flow) {
       p.trackKeyframe(cloud);
       result.T_curr_prev = rigidInverse(result.T_world_curr) * p.T_world_prev;
     }

@@ -71,10 +71,10 @@ parameterFlags()
        "",
        "frame-to-frame registration only, no keyframe",
        S::all},
-      {"refine",
-       "registration.refinement",
+      {"backend",
+       "registration.backend",
        "",
-       "refinement of the static registration",
+       "ego-motion method on the static mask, from the flow estimate",
        S::all},
   };
   return flags;
@@ -92,7 +92,7 @@ fieldOf(const ParameterFlag& flag)
   return pipelineConfigTable().field(flag.key);
 }
 
-/// "none|icp|gicp" for a choice, else the flag's own value name.
+/// "flow|cv_rgbd|icp|gicp" for a choice, else the flag's own value name.
 std::string
 valueName(const ParameterFlag& flag)
 {

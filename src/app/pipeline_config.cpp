@@ -89,6 +89,8 @@ pipelineConfigTable()
                  RigidMotionSegmentationParameters::table().fields()),
       nestFields("registration", &P::registration,
                  StaticSceneRegistrationParameters::table().fields()),
+      nestFields("registration", &P::backend,
+                 StaticMaskRegistrationParameters::table().fields()),
       prefixFields("pipeline", {own.field("use_segmentation")}),
       nestFields("pipeline", &P::static_set,
                  StaticSetSelectionParameters::table().fields()),

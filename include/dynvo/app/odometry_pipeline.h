@@ -7,6 +7,7 @@
 #include <dynvo/common/parameter_table.h>
 #include <dynvo/motion_segmentation/rigid_motion_segmentation_parameters.h>
 #include <dynvo/registration/inlier_noise_tracker.h>
+#include <dynvo/registration/static_mask_registration_parameters.h>
 #include <dynvo/registration/static_scene_registration_parameters.h>
 #include <dynvo/registration/static_set_selection_parameters.h>
 #include <dynvo/scene_flow/grid_scene_flow_parameters.h>
@@ -39,6 +40,9 @@ struct DYNVO_EXPORTS PipelineOptions {
   RigidMotionSegmentationParameters
       segmentation; ///< docs/algorithm.md §3-§6 (seed included)
   StaticSceneRegistrationParameters registration; ///< docs/algorithm.md §7
+  /// The ego-motion method on the static mask, from the flow estimate (StaticMaskRegistration;
+  /// YAML registration.backend, registration.icp_*, registration.rgbd_*).
+  StaticMaskRegistrationParameters backend;
   bool use_segmentation =
       true; ///< false: ablation, every valid flow cell counts as static
   /// Static consensus and motion guard (StaticSetSelection; YAML pipeline.static_consensus);
@@ -50,6 +54,7 @@ struct DYNVO_EXPORTS PipelineOptions {
   unsigned threads = 1; ///< worker threads; results do not depend on it
   /// Keyframe registration (docs/algorithm.md §7.3): the static cells of each frame are also
   /// registered against the current keyframe, which gives the pose; false: frame to frame.
+  /// Only with the flow backend (backend.backend); the other backends run frame to frame.
   bool keyframes = true;
   /// A new keyframe is taken when the inliers of the fit to the keyframe drop below this
   /// share of those of the first fit to it (static overlap, (0, 1]) ...

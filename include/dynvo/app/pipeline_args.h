@@ -26,7 +26,7 @@ enum class PipelineStages {
  *
  * Both: -config, -write_config, -threads, -cell_size, -window_size, -max_pyramid_level,
  * -fb_check, -v, -q. PipelineStages::all adds -seed, -no_tracking, -no_segmentation,
- * -refine, -max_frames and the shared outputs -objects, -objects_dir, -clouds_dir and
+ * -backend, -max_frames and the shared outputs -objects, -objects_dir, -clouds_dir and
  * -clouds_every (runOutputPathsFromArguments()). Each parameter flag sets a key of
  * pipelineConfigTable() (its help names the key) and defaults to that key's value in
  * PipelineOptions(), so a flag means the same in every app and in a -config file.

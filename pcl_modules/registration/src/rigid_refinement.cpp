@@ -16,16 +16,15 @@ bool
 runRefinement(RegistrationT& registration,
               const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& source,
               const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& target,
-              const StaticSceneRegistrationParameters& parameters,
+              const StaticMaskRegistrationParameters& parameters,
               const Eigen::Matrix4f& guess,
               Eigen::Matrix4f& T_target_source)
 {
   registration.setInputSource(source);
   registration.setInputTarget(target);
-  registration.setMaxCorrespondenceDistance(
-      parameters.refinement_max_correspondence_distance);
-  registration.setMaximumIterations(parameters.refinement_max_iterations);
-  registration.setTransformationEpsilon(parameters.refinement_transformation_epsilon);
+  registration.setMaxCorrespondenceDistance(parameters.icp_max_correspondence_distance);
+  registration.setMaximumIterations(parameters.icp_max_iterations);
+  registration.setTransformationEpsilon(parameters.icp_transformation_epsilon);
   pcl::PointCloud<pcl::PointXYZ> aligned;
   registration.align(aligned, guess);
   if (!registration.hasConverged())
@@ -39,21 +38,21 @@ runRefinement(RegistrationT& registration,
 bool
 refineRigidTransformation(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& source,
                           const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& target,
-                          RegistrationRefinement method,
-                          const StaticSceneRegistrationParameters& parameters,
+                          const StaticMaskRegistrationParameters& parameters,
                           const Eigen::Matrix4f& guess,
                           Eigen::Matrix4f& T_target_source)
 {
-  switch (method) {
-  case RegistrationRefinement::icp: {
+  switch (parameters.backend) {
+  case RegistrationBackend::icp: {
     pcl::IterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ> icp;
     return runRefinement(icp, source, target, parameters, guess, T_target_source);
   }
-  case RegistrationRefinement::gicp: {
+  case RegistrationBackend::gicp: {
     pcl::GeneralizedIterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ> gicp;
     return runRefinement(gicp, source, target, parameters, guess, T_target_source);
   }
-  case RegistrationRefinement::none:
+  case RegistrationBackend::flow:
+  case RegistrationBackend::cv_rgbd:
     break;
   }
   return false;

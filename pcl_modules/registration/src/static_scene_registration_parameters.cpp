@@ -9,21 +9,12 @@ StaticSceneRegistrationParameters::table()
 {
   using P = StaticSceneRegistrationParameters;
   using R = FieldRange;
-  static_assert(AGGREGATE_FIELD_COUNT<P> == 9, "every field of P needs a row below");
+  static_assert(AGGREGATE_FIELD_COUNT<P> == 4, "every field of P needs a row below");
   static const ParameterTable<P> table(std::vector<ParameterTable<P>::Field>{
       makeField("th_inlier", &P::th_inlier, R::above(0), "th_inlier, m^2"),
       makeField("trim_factor", &P::trim_factor, R::atLeast(1), "trim"),
       makeField("trim_rounds", &P::trim_rounds, R::atLeast(0), "trim rounds"),
       makeField("min_correspondences", &P::min_correspondences, R::atLeast(3), "cells"),
-      makeChoiceField("refinement", &P::refinement, {"none", "icp", "gicp"},
-                      "ICP/GICP after the flow estimate"),
-      makeField("refinement_max_correspondence_distance",
-                &P::refinement_max_correspondence_distance, R::above(0), "metres"),
-      makeField("refinement_max_iterations", &P::refinement_max_iterations,
-                R::atLeast(1), "ICP/GICP iterations"),
-      makeField("refinement_transformation_epsilon",
-                &P::refinement_transformation_epsilon, R::atLeast(0), "m^2"),
-      makeField("refinement_stride", &P::refinement_stride, R::atLeast(1), "px"),
   });
   return table;
 }

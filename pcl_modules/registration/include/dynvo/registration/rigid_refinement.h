@@ -4,7 +4,7 @@
 #pragma once
 
 #include <dynvo/common/export.h>
-#include <dynvo/registration/static_scene_registration_parameters.h>
+#include <dynvo/registration/static_mask_registration_parameters.h>
 
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
@@ -16,9 +16,9 @@ namespace dynvo::detail {
 /** \brief Refines T_target_source with ICP or GICP.
  * \param[in] source finite points to move (metres, source frame)
  * \param[in] target finite points to align to (metres, target frame)
- * \param[in] method icp or gicp (none returns false)
- * \param[in] parameters refinement_max_correspondence_distance, refinement_max_iterations and
- *            refinement_transformation_epsilon are used
+ * \param[in] parameters backend (icp or gicp; any other returns false),
+ *            icp_max_correspondence_distance, icp_max_iterations and
+ *            icp_transformation_epsilon are used
  * \param[in] guess initial T_target_source
  * \param[out] T_target_source refined transformation; written only when the method converged
  * \return true when PCL reports convergence
@@ -26,8 +26,7 @@ namespace dynvo::detail {
 DYNVO_EXPORTS bool
 refineRigidTransformation(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& source,
                           const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& target,
-                          RegistrationRefinement method,
-                          const StaticSceneRegistrationParameters& parameters,
+                          const StaticMaskRegistrationParameters& parameters,
                           const Eigen::Matrix4f& guess,
                           Eigen::Matrix4f& T_target_source);
 

@@ -28,8 +28,7 @@ enum class StaticRegistrationStatus {
   invalid_input, ///< the inputs broke the contract (logged with PCL_ERROR); not converged
   too_few_correspondences, ///< fewer than min_correspondences usable static cells; not converged
   degenerate,              ///< the static cells are (nearly) collinear; not converged
-  converged, ///< the result is the trimmed flow estimate, refined if refinement != none
-  refinement_not_converged ///< converged, but ICP/GICP failed: the result is the flow estimate
+  converged ///< the result is the trimmed flow estimate
 };
 
 /** \brief Camera ego-motion from the static cells of a grid scene flow: Lee, Son & Kim, "Robust
@@ -54,22 +53,16 @@ enum class StaticRegistrationStatus {
  * trim_rounds rounds keep the cells of S with E_i <= trim_factor * th_inlier and refit; a round
  * leaving fewer than min_correspondences cells, or a degenerate refit, keeps the previous fit.
  *
- * Refinement (optional): ICP or GICP on plain XYZ copies of the finite static source points
- * (the pixels of the static cells, or else the listed indices; every refinement_stride-th row
- * and column) against the finite points of the whole target on
- * the same lattice, initialised with the flow estimate. Moving objects in the previous frame are
- * kept out only by the maximum correspondence distance. pcl::Registration's knobs are the
- * refinement's: setMaximumIterations(), setMaxCorrespondenceDistance() and
- * setTransformationEpsilon() are refinement_max_iterations,
- * refinement_max_correspondence_distance and refinement_transformation_epsilon of
- * Parameters (setParameters() sets them, getParameters() reads them back). Correspondence
- * estimation and rejectors are not used: the flow gives the correspondences.
+ * The fit is closed-form on the flow's correspondences: pcl::Registration's iteration,
+ * correspondence-distance and epsilon knobs, correspondence estimation and rejectors are not
+ * used. Other methods on the static mask (OpenCV's RGB-D odometry, ICP, GICP) started from
+ * this estimate are StaticMaskRegistration's.
  *
  * Results: hasConverged() is false for invalid input, too few cells (|S| < min_correspondences)
  * and degenerate cells; getStatus() says which, and getFinalTransformation() is then the guess
  * passed to align() (identity by default), so a pipeline can pass its constant-velocity
  * prediction and flag the frame as lost. getMeanSquaredResidual() is the mean squared
- * residual E_i (m^2) of the kept cells under the final transformation (also after refinement);
+ * residual E_i (m^2) of the kept cells under the final transformation;
  * getFitnessScore(max_range) keeps PCL's meaning (mean squared distance of the source points to
  * their nearest target points, on a kd-tree built on the first call only).
  * getNumberOfCorrespondences() is |S|, getNumberOfInliers() the number of kept cells.
@@ -112,7 +105,6 @@ public:
   using FlowCloudConstPtr = FlowCloud::ConstPtr;
   using Matrix4 = typename Base::Matrix4;
   using Parameters = StaticSceneRegistrationParameters;
-  using Refinement = RegistrationRefinement;
   using Status = StaticRegistrationStatus;
 
   /// Sets the class name, the lazily built target kd-tree and the default parameters.
@@ -173,45 +165,30 @@ public:
 
   Status getStatus() const { return status_; }
 
-  /// T_prev_curr of the trimmed flow estimate, before any refinement (the guess when it failed).
-  const Matrix4& getFlowTransformation() const { return flow_transformation_; }
-
-  /** \brief All knobs at once, the three refinement_* limits into pcl::Registration's
-   * setMaximumIterations(), setMaxCorrespondenceDistance() and setTransformationEpsilon().
-   * \throws std::invalid_argument when parameters.validate() fails
-   */
+  /// All knobs at once. \throws std::invalid_argument when parameters.validate() fails
   void setParameters(const Parameters& parameters);
 
-  /// The knobs, the three refinement_* limits read from pcl::Registration's.
-  Parameters getParameters() const;
+  const Parameters& getParameters() const { return params_; }
 
-  // One setter/getter pair per field of Parameters, except the three that are
-  // pcl::Registration's (see the class doc). A setter throws std::invalid_argument when the
-  // value is outside the field's own range (StaticSceneRegistrationParameters::table()) and
-  // keeps the old value. pcl::Registration's setters do not check; align() throws
-  // std::invalid_argument when getParameters().validate() fails.
+  // One setter/getter pair per field of Parameters. A setter throws std::invalid_argument
+  // when the value is outside the field's own range (StaticSceneRegistrationParameters::
+  // table()) and keeps the old value.
   DYNVO_PARAMETER_ACCESSORS(InlierThreshold, th_inlier)
   DYNVO_PARAMETER_ACCESSORS(TrimFactor, trim_factor)
   DYNVO_PARAMETER_ACCESSORS(TrimRounds, trim_rounds)
   DYNVO_PARAMETER_ACCESSORS(MinCorrespondences, min_correspondences)
-  DYNVO_PARAMETER_ACCESSORS(Refinement, refinement)
-  DYNVO_PARAMETER_ACCESSORS(RefinementStride, refinement_stride)
 
 protected:
   using Base::converged_;
-  using Base::corr_dist_threshold_;
   using Base::fake_indices_;
   using Base::final_transformation_;
   using Base::indices_;
   using Base::input_;
-  using Base::max_iterations_;
   using Base::reg_name_;
   using Base::target_;
   using Base::transformation_;
-  using Base::transformation_epsilon_;
 
-  /// Checks the inputs, runs the flow estimate and the optional refinement (called by
-  /// pcl::Registration::align). \throws std::invalid_argument on invalid parameters
+  /// Checks the inputs and runs the flow estimate (called by pcl::Registration::align).
   void computeTransformation(PointCloud& output, const Matrix4& guess) override;
 
   /// Non-null organized source, target and flow; equal source and target sizes; a flow grid
@@ -233,12 +210,8 @@ protected:
   /// Weighted fit on S, then trimming. Sets status_, flow_transformation_ and inliers_.
   bool estimateFromFlow();
 
-  /// ICP/GICP from flow_transformation_; true and writes refined when PCL reports convergence.
-  bool refine(const Parameters& parameters, Matrix4& refined) const;
-
 private:
-  /// Stores checked parameters from a per-field setter (the three refinement_* limits stay
-  /// pcl::Registration's).
+  /// Stores checked parameters.
   void assignParameters(const Parameters& parameters) { params_ = parameters; }
 
   /// Clears every result; the final transformation becomes the guess.

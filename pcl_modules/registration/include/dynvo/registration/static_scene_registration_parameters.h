@@ -7,19 +7,12 @@
 
 namespace dynvo {
 
-/// Optional refinement run after the flow estimate, on the static points only.
-enum class RegistrationRefinement {
-  none, ///< the trimmed flow estimate is the result (the paper's method)
-  icp, ///< pcl::IterativeClosestPoint (point-to-point), initialised with the flow estimate
-  gicp ///< pcl::GeneralizedIterativeClosestPoint (plane-to-plane), initialised likewise
-};
-
 /** \brief Parameters of StaticSceneRegistration (the single source of the defaults).
  *
  * The flow estimate follows docs/algorithm.md §7: a weighted least-squares fit on the
  * static cells,
  * then trim_rounds rounds that keep the cells with E_i <= trim_factor * th_inlier and refit.
- * The refinement_* fields only matter when refinement != none.
+ * Other methods on the static mask are StaticMaskRegistration's.
  */
 struct DYNVO_EXPORTS StaticSceneRegistrationParameters {
   float th_inlier = 3e-5f; ///< th_inlier (m^2, > 0): E_i of an inlier, 5.5 mm squared
@@ -29,15 +22,6 @@ struct DYNVO_EXPORTS StaticSceneRegistrationParameters {
       2; ///< trim rounds (>= 0): trim-and-refit rounds after the first fit
   int min_correspondences =
       6; ///< (>= 3): fewer usable static cells is "too few"; a trim round leaving fewer keeps the previous fit
-  RegistrationRefinement refinement =
-      RegistrationRefinement::none; ///< optional ICP/GICP refinement
-  double refinement_max_correspondence_distance =
-      0.05; ///< (metres, > 0): ICP/GICP pairs farther apart are ignored
-  int refinement_max_iterations = 30; ///< (>= 1): ICP/GICP iteration cap
-  double refinement_transformation_epsilon =
-      1e-8; ///< (m^2, >= 0): ICP/GICP stop when the squared translation step is smaller
-  int refinement_stride =
-      4; ///< (px, >= 1): ICP/GICP use every stride-th row and column of both frames (19,200 target points at VGA)
 
   /// Names, units and ranges of the fields above, in file order (ParameterTable).
   static const ParameterTable<StaticSceneRegistrationParameters>& table();

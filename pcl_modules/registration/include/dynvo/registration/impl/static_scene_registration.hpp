@@ -3,7 +3,6 @@
 #pragma once
 
 #include <dynvo/common/rigid_fit.h>
-#include <dynvo/registration/rigid_refinement.h>
 #include <dynvo/registration/static_scene_registration.h>
 
 #include <pcl/common/transforms.h>
@@ -28,20 +27,6 @@ StaticSceneRegistration<PointT>::setParameters(const Parameters& parameters)
 {
   parameters.validate();
   assignParameters(parameters);
-  max_iterations_ = parameters.refinement_max_iterations;
-  corr_dist_threshold_ = parameters.refinement_max_correspondence_distance;
-  transformation_epsilon_ = parameters.refinement_transformation_epsilon;
-}
-
-template <typename PointT>
-typename StaticSceneRegistration<PointT>::Parameters
-StaticSceneRegistration<PointT>::getParameters() const
-{
-  Parameters parameters = params_;
-  parameters.refinement_max_iterations = max_iterations_;
-  parameters.refinement_max_correspondence_distance = corr_dist_threshold_;
-  parameters.refinement_transformation_epsilon = transformation_epsilon_;
-  return parameters;
 }
 
 template <typename PointT>
@@ -245,55 +230,10 @@ StaticSceneRegistration<PointT>::estimateFromFlow()
 }
 
 template <typename PointT>
-bool
-StaticSceneRegistration<PointT>::refine(const Parameters& parameters,
-                                        Matrix4& refined) const
-{
-  const std::size_t stride = static_cast<std::size_t>(parameters.refinement_stride);
-  const std::size_t width = input_->width;
-  const auto on_lattice = [stride, width](std::size_t index) {
-    return index % width % stride == 0 && index / width % stride == 0;
-  };
-  pcl::PointCloud<pcl::PointXYZ>::Ptr source(new pcl::PointCloud<pcl::PointXYZ>);
-  const auto add_source = [&](std::size_t index) {
-    const PointT& p = (*input_)[index];
-    if (on_lattice(index) && pcl::isXYZFinite(p))
-      source->push_back(pcl::PointXYZ(p.x, p.y, p.z));
-  };
-  if (static_cells_input_.size() > 0) {
-    for (std::size_t i = 0; i < grid_.size(); ++i)
-      if (static_cells_[i])
-        grid_.forEachPixel(i, add_source);
-  }
-  else {
-    for (const auto index : *indices_)
-      add_source(static_cast<std::size_t>(index));
-  }
-  pcl::PointCloud<pcl::PointXYZ>::Ptr target(new pcl::PointCloud<pcl::PointXYZ>);
-  for (std::size_t index = 0; index < target_->size(); ++index) {
-    const PointT& p = (*target_)[index];
-    if (on_lattice(index) && pcl::isXYZFinite(p))
-      target->push_back(pcl::PointXYZ(p.x, p.y, p.z));
-  }
-  const auto min_count = static_cast<std::size_t>(params_.min_correspondences);
-  if (source->size() < min_count || target->size() < min_count) {
-    PCL_DEBUG("[dynvo::%s::align] %zu source / %zu target points on the refinement "
-              "lattice.\n",
-              reg_name_.c_str(), source->size(), target->size());
-    return false;
-  }
-  return detail::refineRigidTransformation(source, target, parameters.refinement,
-                                           parameters, flow_transformation_, refined);
-}
-
-template <typename PointT>
 void
 StaticSceneRegistration<PointT>::computeTransformation(PointCloud& output,
                                                        const Matrix4& guess)
 {
-  const Parameters parameters = getParameters();
-  // The per-field setters and pcl::Registration's do not check what ties the fields.
-  parameters.validate();
   resetResults(guess);
   if (!validateInputs()) {
     output.clear();
@@ -307,13 +247,6 @@ StaticSceneRegistration<PointT>::computeTransformation(PointCloud& output,
   converged_ = true;
   status_ = Status::converged;
   final_transformation_ = flow_transformation_;
-  if (params_.refinement != Refinement::none) {
-    Matrix4 refined;
-    if (refine(parameters, refined))
-      final_transformation_ = refined;
-    else
-      status_ = Status::refinement_not_converged;
-  }
   transformation_ = final_transformation_;
   const Eigen::Matrix4d T_final = final_transformation_.template cast<double>();
   double residual_sum = 0.0;

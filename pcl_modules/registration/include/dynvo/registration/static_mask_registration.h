@@ -1,0 +1,153 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The ego-motion backend restricted to the static mask of both frames (docs/algorithm.md §7,
+// the paper's Table III).
+#pragma once
+
+#include <dynvo/common/camera.h>
+#include <dynvo/common/flow_grid.h>
+#include <dynvo/registration/static_mask_registration_parameters.h>
+
+#include <pcl/point_cloud.h>
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <string>
+
+namespace dynvo {
+
+/// What the last align() of StaticMaskRegistration produced.
+enum class StaticMaskRegistrationStatus {
+  not_computed,   ///< align() has not run yet
+  flow,           ///< the backend is flow: the guess is the result
+  invalid_input,  ///< the inputs broke the contract (logged with PCL_ERROR): the guess
+  too_few_points, ///< fewer than MIN_POINTS usable masked points: the guess
+  not_converged,  ///< the backend did not converge: the guess
+  converged       ///< the backend's estimate is the result
+};
+
+/** \brief Re-estimates the ego-motion with another method restricted to the static mask,
+ * started from the flow estimate: the experiment of Lee, Son & Kim, "Robust Real-time RGB-D
+ * Visual Odometry in Dynamic Environments via Rigid Motion Model", IROS 2019, Table III (a
+ * dense or ICP odometry made robust by the segmentation's mask).
+ *
+ * The source (setInputSource) is the current frame k, the target (setInputTarget) the
+ * previous frame k-1, both organized with the same size (metres, RGB), and the result is
+ * T_prev_curr, as for StaticSceneRegistration. The mask of each frame comes as cells
+ * (setSourceStaticCells(), setTargetStaticCells(): the cells labelled LABEL_STATIC, on the
+ * grid of the flow); a pixel belongs to the mask when its cell does. The pipeline passes the
+ * static set of the final flow fit of frame k (StaticSetSelection::getStaticCells()) as the
+ * source mask and that of frame k-1 (kept from the previous step) as the target mask.
+ *
+ * Backends (Parameters::backend):
+ * - flow: align() returns the guess (the flow estimate is the method);
+ * - cv_rgbd: cv::rgbd::RgbdOdometry (photometric, dense) on the gray image and depth of both
+ *   frames, with both masks (OpenCV uses the source mask for the points it moves and the
+ *   target mask for the textured pixels it compares with), initialised with the guess;
+ * - icp, gicp: PCL's ICP/GICP on plain XYZ copies of the finite masked points of both frames
+ *   on every icp_stride-th row and column, initialised with the guess.
+ * A backend that fails (too few points, not converged) leaves the guess as the result, and
+ * getStatus() says why. The camera intrinsics (setCameraIntrinsics()) are used by cv_rgbd.
+ * \code
+ * dynvo::StaticMaskRegistration<pcl::PointXYZRGB> backend;
+ * backend.setCameraIntrinsics(intrinsics);
+ * backend.setBackend(dynvo::RegistrationBackend::cv_rgbd);
+ * backend.setInputSource(current);                           // frame k
+ * backend.setInputTarget(previous);                          // frame k-1
+ * backend.setSourceStaticCells(selection.getStaticCells());  // static set of frame k
+ * backend.setTargetStaticCells(previous_static_cells);       // static set of frame k-1
+ * Eigen::Matrix4f T_prev_curr;
+ * backend.align(registration.getFinalTransformation(), T_prev_curr);
+ * \endcode
+ * Not thread-safe; separate instances may run concurrently. Explicitly instantiated for
+ * pcl::PointXYZRGB and pcl::PointXYZRGBA (other types: include the impl .hpp).
+ */
+template <typename PointT> class StaticMaskRegistration {
+public:
+  using PointCloud = pcl::PointCloud<PointT>;
+  using PointCloudConstPtr = typename PointCloud::ConstPtr;
+  using Parameters = StaticMaskRegistrationParameters;
+  using Status = StaticMaskRegistrationStatus;
+
+  /// Fewer usable masked points (icp, gicp: finite lattice points; cv_rgbd: masked pixels)
+  /// in either frame than this is too few: a rigid motion needs 3, with a margin.
+  static constexpr std::size_t MIN_POINTS = 6;
+
+  /// Name used in log prefixes: "StaticMaskRegistration".
+  const std::string& getClassName() const { return class_name_; }
+
+  /// All knobs at once. \throws std::invalid_argument when parameters.validate() fails
+  void setParameters(const Parameters& parameters)
+  {
+    parameters.validate();
+    assignParameters(parameters);
+  }
+
+  const Parameters& getParameters() const { return params_; }
+
+  // A setter throws std::invalid_argument when the value is outside the field's own range
+  // (StaticMaskRegistrationParameters::table()) and keeps the old value.
+  DYNVO_PARAMETER_ACCESSORS(Backend, backend)
+  DYNVO_PARAMETER_ACCESSORS(IcpStride, icp_stride)
+
+  /// Pinhole model of both frames (cv_rgbd). \throws std::invalid_argument when invalid
+  void setCameraIntrinsics(const CameraIntrinsics& intrinsics)
+  {
+    intrinsics.validate();
+    intrinsics_ = intrinsics;
+  }
+
+  const CameraIntrinsics& getCameraIntrinsics() const { return intrinsics_; }
+
+  /// Frame k (organized, metres).
+  void setInputSource(const PointCloudConstPtr& cloud) { source_ = cloud; }
+
+  /// Frame k-1 (organized, metres, the source's size).
+  void setInputTarget(const PointCloudConstPtr& cloud) { target_ = cloud; }
+
+  /// Static cells of frame k (labelled LABEL_STATIC), on a grid over the source image.
+  void setSourceStaticCells(const FlowGrid& cells) { source_cells_ = cells; }
+
+  /// Static cells of frame k-1 (labelled LABEL_STATIC), on a grid over the target image.
+  void setTargetStaticCells(const FlowGrid& cells) { target_cells_ = cells; }
+
+  /** \brief Runs the backend from guess.
+   * \param[in] guess initial T_prev_curr (metres), e.g. the flow estimate
+   * \param[out] T_prev_curr the backend's estimate, or guess when it failed (getStatus())
+   * \return true when the result is the backend's own estimate (flow: always true)
+   */
+  bool align(const Eigen::Matrix4f& guess, Eigen::Matrix4f& T_prev_curr);
+
+  Status getStatus() const { return status_; }
+
+private:
+  /// Stores checked parameters.
+  void assignParameters(const Parameters& parameters) { params_ = parameters; }
+
+  /// Non-null organized clouds of equal size, masks on grids over them; logs PCL_ERROR.
+  bool validateInputs() const;
+
+  /// True when both counts reach MIN_POINTS; logs PCL_DEBUG otherwise.
+  bool enoughPoints(std::size_t source_count, std::size_t target_count) const;
+
+  /// ICP/GICP on the masked lattice points; T_prev_curr written when converged.
+  Status alignPoints(const Eigen::Matrix4f& guess, Eigen::Matrix4f& T_prev_curr);
+
+  /// cv::rgbd::RgbdOdometry on the masked images; T_prev_curr written when converged.
+  Status alignImages(const Eigen::Matrix4f& guess, Eigen::Matrix4f& T_prev_curr);
+
+  std::string class_name_ = "StaticMaskRegistration"; ///< log prefix
+  Parameters params_;                                 ///< validated knobs
+  CameraIntrinsics intrinsics_;                       ///< of both frames
+  PointCloudConstPtr source_;                         ///< frame k
+  PointCloudConstPtr target_;                         ///< frame k-1
+  FlowGrid source_cells_;                             ///< static cells of frame k
+  FlowGrid target_cells_;                             ///< static cells of frame k-1
+  Status status_ = Status::not_computed;              ///< outcome of the last align()
+};
+
+} // namespace dynvo
+
+#ifdef DYNVO_NO_PRECOMPILE
+#include <dynvo/registration/impl/static_mask_registration.hpp>
+#endif
