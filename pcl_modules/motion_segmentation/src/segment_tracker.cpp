@@ -68,6 +68,7 @@ void
 SegmentTracker::reset()
 {
   buffer_.clear();
+  labels_exhausted_ = false;
   model_ = DualLabelModel();
   source_.clear();
   tracked_.clear();
@@ -208,14 +209,8 @@ SegmentTracker::matchSegments(const GridFlowData& grid,
   }
   // New ids for unmatched segments, largest first.
   for (int i = 1; i <= g; ++i)
-    if (ids[i] == 0) {
+    if (ids[i] == 0)
       ids[i] = freeId(ids);
-      if (ids[i] == 0)
-        PCL_WARN(
-            "[dynvo::SegmentTracker::update] all %d labels in use; a segment of %d "
-            "cells is left unlabelled.\n",
-            labels, spatial.sizes[i - 1]);
-    }
   return ids;
 }
 
@@ -502,6 +497,13 @@ SegmentTracker::update(const GridFlowData& grid,
 
   // §4: persistent ids for this frame's segments.
   std::vector<int> ids = matchSegments(grid, spatial, params);
+  // Busy real scenes run out of labels over and over: said once per sequence.
+  if (!labels_exhausted_ && std::find(ids.begin() + 1, ids.end(), 0) != ids.end()) {
+    PCL_WARN("[dynvo::SegmentTracker::update] all %d labels in use: segments without a "
+             "free label are left unlabelled (said once per sequence).\n",
+             params.max_labels);
+    labels_exhausted_ = true;
+  }
   // [D] The guard needs a prediction: none exists for the first pair of a sequence (the
   // pipeline's identity would hand label 1 to whatever moves least in the image).
   if (grid.information.empty() || hasHistory())

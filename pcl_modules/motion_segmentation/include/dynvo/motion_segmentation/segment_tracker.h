@@ -154,6 +154,7 @@ private:
   std::vector<std::uint8_t> fused_;     ///< output labels
   std::vector<std::uint8_t> previous_fused_; ///< output labels of the previous frame
   std::vector<char> separated_;   ///< per id: kept apart from the background lately
+  bool labels_exhausted_ = false; ///< the running-out-of-labels warning was given
   std::vector<std::uint8_t> ids_; ///< output ids
   std::vector<Eigen::Matrix4d> motions_; ///< motion per output id
   std::vector<char> used_;               ///< ids taken at the start of the frame
