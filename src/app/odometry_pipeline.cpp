@@ -154,15 +154,8 @@ struct OdometryPipeline::Impl {
    */
   void trackKeyframe(const Cloud::ConstPtr& cloud)
   {
-    if (keyframe_is_previous) {
-      // The frame-to-frame fit is the first fit to the keyframe: its reference inliers.
-      keyframe_is_previous = false;
-      keyframe_inliers = result.lost ? 0 : registration.getNumberOfInliers();
-      result.keyframe_overlap = result.lost ? 0.0 : 1.0;
-    }
-    else if (flow_estimation.getKeyframeCloud()) {
+    if (flow_estimation.getKeyframeCloud())
       registerToKeyframe(cloud);
-    }
     const Eigen::Matrix4d T_keyframe_curr =
         rigidInverse(T_world_keyframe) * result.T_world_curr;
     const double angle =
@@ -182,7 +175,7 @@ struct OdometryPipeline::Impl {
         angle, renew ? ", new keyframe" : "");
     if (renew && !result.lost && flow_estimation.setCurrentAsKeyframe()) {
       T_world_keyframe = result.T_world_curr;
-      keyframe_is_previous = true;
+      keyframe_inliers = 0;
       result.keyframe = true;
     }
   }
@@ -212,11 +205,14 @@ struct OdometryPipeline::Impl {
           T_world_keyframe *
           keyframe_registration.getFinalTransformation().cast<double>();
       result.lost = false;
+      // The first fit to a keyframe (the frame after it) is the reference of its overlap.
+      const std::size_t inliers = keyframe_registration.getNumberOfInliers();
+      if (keyframe_inliers == 0)
+        keyframe_inliers = inliers;
       result.keyframe_overlap =
-          keyframe_inliers == 0
-              ? 0.0
-              : static_cast<double>(keyframe_registration.getNumberOfInliers()) /
-                    static_cast<double>(keyframe_inliers);
+          keyframe_inliers == 0 ? 0.0
+                                : static_cast<double>(inliers) /
+                                      static_cast<double>(keyframe_inliers);
     }
     result.times.registration_ms += millisecondsSince(registration_start);
   }
@@ -248,8 +244,7 @@ struct OdometryPipeline::Impl {
   pcl::PointCloud<PointFlow>::Ptr keyframe_flow =
       pcl::make_shared<pcl::PointCloud<PointFlow>>();
   Eigen::Matrix4d T_world_keyframe = Eigen::Matrix4d::Identity();
-  bool keyframe_is_previous = false; ///< the keyframe is the previous frame
-  std::size_t keyframe_inliers = 0;  ///< inliers of the first fit to the keyframe
+  std::size_t keyframe_inliers = 0; ///< inliers of the first fit to the keyframe (0: none yet)
   StaticSetSelection<pcl::PointXYZRGB> selection;
   InlierNoiseTracker noise_tracker;
   StaticMaskRegistration<pcl::PointXYZRGB> backend;

@@ -92,8 +92,8 @@ struct FrameResult {
   bool lost = false;
   /// this frame became the keyframe later frames are registered against
   bool keyframe = false;
-  /// inliers of the fit to the keyframe over those of the first fit to it (1 for the first
-  /// fit; 0 when the fit failed or keyframes are off)
+  /// inliers of the fit to the keyframe over those of the first fit to it, on the frame
+  /// after the keyframe (1 there; 0 when the fit failed or keyframes are off)
   double keyframe_overlap = 0.0;
   /// segments[0] = static background pixels, then moving objects (pcl::PointIndices each)
   std::vector<pcl::PointIndices> segments;
