@@ -7,6 +7,15 @@
 
 namespace dynvo {
 
+/// Grey level of a colour: ITU-R BT.601 luma in 14-bit fixed point, the weights and
+/// rounding of cv::cvtColor(RGB2GRAY). Every grey image of the project (scene flow, the
+/// cv_rgbd backend, the pixel refinement) is made with it.
+inline std::uint8_t
+luma(std::uint8_t r, std::uint8_t g, std::uint8_t b)
+{
+  return static_cast<std::uint8_t>((4899u * r + 9617u * g + 1868u * b + 8192u) >> 14);
+}
+
 /// 8-bit colour image, row-major, 3 bytes per pixel in R, G, B order.
 struct ColorImage {
   std::uint32_t width = 0;        ///< columns (px)

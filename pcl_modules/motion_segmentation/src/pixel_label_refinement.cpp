@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Cell labels to pixel labels (docs/algorithm.md §6.1).
 #include <dynvo/motion_segmentation/pixel_label_refinement.h>
+#include <dynvo/common/image.h>
 
 #include <algorithm>
 #include <cmath>
@@ -19,13 +20,13 @@ hasDepth(float z)
   return std::isfinite(z) && z > 0.0f;
 }
 
-/// Grey level (mean of r, g, b) of a PCL packed rgba word.
+/// Grey level (luma) of a PCL packed rgba word (b in the low byte, then g, r).
 inline float
 greyOf(std::uint32_t rgba)
 {
-  return static_cast<float>((rgba & 0xffu) + (rgba >> 8 & 0xffu) +
-                            (rgba >> 16 & 0xffu)) /
-         3.0f;
+  return luma(static_cast<std::uint8_t>(rgba >> 16 & 0xffu),
+              static_cast<std::uint8_t>(rgba >> 8 & 0xffu),
+              static_cast<std::uint8_t>(rgba & 0xffu));
 }
 
 } // namespace

@@ -2,6 +2,7 @@
 // Template bodies of StaticMaskRegistration (compiled in src/ for XYZRGB and XYZRGBA).
 #pragma once
 
+#include <dynvo/common/image.h>
 #include <dynvo/registration/rgbd_odometry.h>
 #include <dynvo/registration/rigid_refinement.h>
 #include <dynvo/registration/static_mask_registration.h>
@@ -62,8 +63,7 @@ rgbdImageOf(const pcl::PointCloud<PointT>& cloud, std::vector<std::uint8_t> mask
   image.depth.resize(cloud.size());
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const PointT& p = cloud[i];
-    image.gray[i] = static_cast<std::uint8_t>(
-        std::lround(0.299f * p.r + 0.587f * p.g + 0.114f * p.b));
+    image.gray[i] = luma(p.r, p.g, p.b);
     image.depth[i] =
         pcl::isXYZFinite(p) ? p.z : std::numeric_limits<float>::quiet_NaN();
   }

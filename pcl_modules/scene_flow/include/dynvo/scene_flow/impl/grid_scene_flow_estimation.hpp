@@ -2,6 +2,7 @@
 // Template bodies of GridSceneFlowEstimation (compiled in src/ for XYZRGB and XYZRGBA).
 #pragma once
 
+#include <dynvo/common/image.h>
 #include <dynvo/common/flow_grid.h>
 #include <dynvo/scene_flow/grid_scene_flow_estimation.h>
 
@@ -135,9 +136,7 @@ GridSceneFlowEstimation<PointT>::prepareFrame(const PointCloud& cloud,
   depth_.resize(size);
   for (std::size_t i = 0; i < size; ++i) {
     const PointT& p = cloud[i];
-    // ITU-R BT.601 luma in 14-bit fixed point, the weights of cv::cvtColor(RGB2GRAY).
-    grey_[i] = static_cast<std::uint8_t>(
-        (4899u * p.r + 9617u * p.g + 1868u * p.b + 8192u) >> 14);
+    grey_[i] = luma(p.r, p.g, p.b);
     depth_[i] = std::isfinite(p.z) ? p.z : std::numeric_limits<float>::quiet_NaN();
   }
   engine_.prepare(slot, grey_, depth_, cloud.width, cloud.height, params_, threads_);
