@@ -54,7 +54,7 @@ TEST(SynthesizeApp, WritesTheSequence)
   ASSERT_EQ(result.exit_code, 0) << result.err;
   for (const char* file :
        {"rgb.txt", "depth.txt", "groundtruth.txt", "objects.txt", "rgb/1.000000.png",
-        "depth/1.005000.png", "labels/1.066667.png"})
+        "depth/1.000000.png", "labels/1.066667.png"})
     EXPECT_TRUE(std::filesystem::exists(dir.file("seq/") + file)) << file;
   EXPECT_NE((result.out + result.err).find(out), std::string::npos);
 }

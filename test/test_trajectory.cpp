@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// interpolatePose: ground truth at a stamp between samples.
+// blendPose and interpolatePose: poses between (and beyond) two samples.
 #include <dynvo/common/trajectory.h>
 
 #include <gtest/gtest.h>
@@ -15,6 +15,29 @@ twoSamples(double gap)
   const Eigen::Isometry3d b = dynvo::test::makePose(Eigen::Vector3d::UnitZ(), 0.2,
                                                     Eigen::Vector3d(1.0, 0.0, 0.0));
   return {{10.0, a}, {10.0 + gap, b}};
+}
+
+TEST(BlendPose, EndsInterpolationAndOneStepBeyond)
+{
+  const auto samples = twoSamples(0.1);
+  const Eigen::Isometry3d& a = samples[0].T_world_camera;
+  const Eigen::Isometry3d& b = samples[1].T_world_camera;
+  const auto expectPose = [](const Eigen::Isometry3d& pose,
+                             const Eigen::Isometry3d& expected) {
+    EXPECT_LT(dynvo::test::translationError(pose.matrix(), expected.matrix()), 1e-9);
+    EXPECT_LT(dynvo::test::rotationError(pose.matrix(), expected.matrix()), 1e-9);
+  };
+  expectPose(dynvo::blendPose(a, b, 0.0), a);
+  expectPose(dynvo::blendPose(a, b, 1.0), b);
+  // Halfway: 0.5 m and 0.1 rad; x = 2 repeats the step (1 m, 0.2 rad about z) once more,
+  // x = -0.5 goes half a step back.
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
+  expectPose(dynvo::blendPose(a, b, 0.5),
+             dynvo::test::makePose(z, 0.1, Eigen::Vector3d(0.5, 0.0, 0.0)));
+  expectPose(dynvo::blendPose(a, b, 2.0),
+             dynvo::test::makePose(z, 0.4, Eigen::Vector3d(2.0, 0.0, 0.0)));
+  expectPose(dynvo::blendPose(a, b, -0.5),
+             dynvo::test::makePose(z, -0.1, Eigen::Vector3d(-0.5, 0.0, 0.0)));
 }
 
 TEST(InterpolatePose, LinearTranslationAndSlerpRotationBetweenSamples)

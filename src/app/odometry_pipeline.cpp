@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <dynvo/app/odometry_pipeline.h>
 #include <dynvo/common/rigid_fit.h>
+#include <dynvo/common/trajectory.h>
 #include <dynvo/io/label_io.h>
 #include <dynvo/motion_segmentation/rigid_motion_segmentation.h>
 #include <dynvo/registration/inlier_noise_tracker.h>
@@ -14,6 +15,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -251,7 +253,9 @@ struct OdometryPipeline::Impl {
   FlowGrid
       previous_static_cells; ///< the static set of the previous frame (the backend's)
   Cloud::ConstPtr previous;
-  Eigen::Matrix4d T_world_prev = Eigen::Matrix4d::Identity();
+  Eigen::Matrix4d T_world_prev =
+      Eigen::Matrix4d::Identity();   ///< at the previous frame's depth instant
+  double previous_depth_stamp = 0.0; ///< seconds
   Eigen::Matrix4d T_curr_prev_predicted = Eigen::Matrix4d::Identity();
   std::size_t frames = 0;
   FrameResult result;
@@ -266,7 +270,8 @@ OdometryPipeline::~OdometryPipeline() = default;
 
 const FrameResult&
 OdometryPipeline::process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& cloud,
-                          double timestamp)
+                          double timestamp,
+                          double depth_timestamp)
 {
   Impl& p = *impl_;
   const auto start = Clock::now();
@@ -317,7 +322,22 @@ OdometryPipeline::process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& clo
   result.labels = paintLabelImage(result.segments, result.segment_labels, result.width,
                                   result.height)
                       .data;
-  p.T_world_prev = result.T_world_curr;
+  // The chain stays at the depth instants; the reported pose moves to the colour stamp.
+  const Eigen::Matrix4d T_world_depth = result.T_world_curr;
+  const double depth_stamp = std::isnan(depth_timestamp) ? timestamp : depth_timestamp;
+  if (p.frames > 0 && depth_stamp != timestamp &&
+      depth_stamp > p.previous_depth_stamp) {
+    // At most one step beyond the depth instant either way: an offset larger than a frame
+    // interval is not a sensor's, and extrapolating it would only add the step's noise.
+    const double x = std::clamp((timestamp - p.previous_depth_stamp) /
+                                    (depth_stamp - p.previous_depth_stamp),
+                                0.0, 2.0);
+    result.T_world_curr = blendPose(Eigen::Isometry3d(p.T_world_prev),
+                                    Eigen::Isometry3d(T_world_depth), x)
+                              .matrix();
+  }
+  p.T_world_prev = T_world_depth;
+  p.previous_depth_stamp = depth_stamp;
   p.previous = cloud;
   ++p.frames;
   result.times.total_ms = millisecondsSince(start);

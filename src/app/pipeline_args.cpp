@@ -283,7 +283,7 @@ runPipeline(const PipelineOptions& options,
       {},
       RunReport(max_frames > 0 ? std::min(max_frames, source.size()) : source.size())};
   end.loop = processFrames(source, max_frames, [&](const Frame& frame) {
-    const auto& result = pipeline.process(frame.cloud, frame.timestamp);
+    const auto& result = pipeline.process(frame.cloud, frame.timestamp, frame.depth_timestamp);
     outputs.add(frame, result);
     if (on_result)
       on_result(frame, result);

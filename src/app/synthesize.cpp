@@ -89,11 +89,10 @@ writeSyntheticSequence(const SynthOptions& options,
     try {
       for (int k = next_frame++; k < frames && !failed; k = next_frame++) {
         const SynthFrame frame = synth.render(k);
-        writer.writeFrame(frame.timestamp, frame.depth_timestamp, frame.color,
+        writer.writeFrame(frame.timestamp, frame.timestamp, frame.color,
                           quantizeDepth(frame.depth, SceneSynthesizer::DEPTH_PNG_SCALE),
                           {frame.color.width, frame.color.height, frame.labels});
-        entries[k] = {frame.timestamp, frame.depth_timestamp,
-                      objectPoses(frame.objects)};
+        entries[k] = {frame.timestamp, frame.timestamp, objectPoses(frame.objects)};
         groundtruth[k] = {frame.timestamp, frame.T_world_camera};
       }
     }

@@ -5,6 +5,17 @@
 
 namespace dynvo {
 
+Eigen::Isometry3d
+blendPose(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, double x)
+{
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = Eigen::Quaterniond(a.linear())
+                      .slerp(x, Eigen::Quaterniond(b.linear()))
+                      .toRotationMatrix();
+  pose.translation() = (1.0 - x) * a.translation() + x * b.translation();
+  return pose;
+}
+
 std::optional<Eigen::Isometry3d>
 interpolatePose(const Trajectory& trajectory, double stamp, double max_gap)
 {
@@ -20,14 +31,8 @@ interpolatePose(const Trajectory& trajectory, double stamp, double max_gap)
   }
   const StampedPose& a = *(after - 1);
   const StampedPose& b = *after;
-  const double x = (stamp - a.timestamp) / (b.timestamp - a.timestamp);
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.linear() = Eigen::Quaterniond(a.T_world_camera.linear())
-                      .slerp(x, Eigen::Quaterniond(b.T_world_camera.linear()))
-                      .toRotationMatrix();
-  pose.translation() =
-      (1.0 - x) * a.T_world_camera.translation() + x * b.T_world_camera.translation();
-  return pose;
+  return blendPose(a.T_world_camera, b.T_world_camera,
+                   (stamp - a.timestamp) / (b.timestamp - a.timestamp));
 }
 
 } // namespace dynvo

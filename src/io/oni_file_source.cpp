@@ -408,7 +408,7 @@ OniFileSource::next(Frame& frame)
 
   const auto& [depth, image] = pair;
   Frame out;
-  out.timestamp = static_cast<double>(depth->stamp_us) * 1e-6;
+  out.timestamp = out.depth_timestamp = static_cast<double>(depth->stamp_us) * 1e-6;
   out.name = impl.file + "#" + std::to_string(index);
   if (image->width != depth->width || image->height != depth->height)
     fail(out.name + ": colour frame is " + std::to_string(image->width) + "x" +

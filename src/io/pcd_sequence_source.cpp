@@ -264,7 +264,8 @@ PcdSequenceSource::next(Frame& frame)
   pcl::fromPCLPointCloud2(blob, *out.cloud);
 
   const double stamp = stampFromName(file);
-  out.timestamp = std::isfinite(stamp) ? stamp : static_cast<double>(cursor_) / fps_;
+  out.timestamp = out.depth_timestamp =
+      std::isfinite(stamp) ? stamp : static_cast<double>(cursor_) / fps_;
 
   const auto& cloud = *out.cloud;
   out.color.width = out.depth.width = cloud.width;

@@ -172,6 +172,7 @@ TumFolderSource::read(std::size_t i) const
   const fs::path dir(folder_);
   Frame frame;
   frame.timestamp = entry.rgb_stamp;
+  frame.depth_timestamp = entry.depth_stamp;
   frame.name = (dir / entry.rgb_file).string();
   frame.color =
       readColorImage((dir / entry.rgb_file).string(), options_.max_frame_pixels);

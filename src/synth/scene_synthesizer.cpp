@@ -228,7 +228,6 @@ SceneSynthesizer::Impl::scriptAt(double t, double t_previous) const
   FrameScript frame;
   // Whole microseconds, so the "%.6f" stamps of the files parse back to these values.
   frame.timestamp = std::round((FIRST_STAMP + t) * 1e6) / 1e6;
-  frame.depth_timestamp = std::round((frame.timestamp + DEPTH_STAMP_DELAY) * 1e6) / 1e6;
   frame.T_world_camera = scenario->camera.pose(scenario->camera_schedule.progress(t));
   for (const detail::ScriptedBox& box : scenario->objects) {
     const double s = box.schedule.progress(t);
@@ -447,7 +446,6 @@ SceneSynthesizer::render(int k) const
   const std::size_t pixels = static_cast<std::size_t>(width) * height;
   SynthFrame frame;
   frame.timestamp = script.timestamp;
-  frame.depth_timestamp = script.depth_timestamp;
   frame.T_world_camera = script.T_world_camera;
   frame.objects = std::move(script.objects);
   frame.color.width = frame.depth.width = width;

@@ -19,8 +19,7 @@ namespace dynvo {
 
 /// Scripted state of one frame (no rendering involved).
 struct FrameScript {
-  double timestamp;                 ///< colour stamp (s)
-  double depth_timestamp;           ///< depth stamp (s)
+  double timestamp;                 ///< colour and depth stamp (s)
   Eigen::Isometry3d T_world_camera; ///< camera-to-world
   std::vector<ObjectState> objects; ///< every scripted object
 };

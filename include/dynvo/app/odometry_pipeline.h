@@ -20,6 +20,7 @@
 #include <Eigen/StdVector>
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -82,9 +83,12 @@ struct StageTimes {
 
 /// Everything the pipeline knows about one frame.
 struct FrameResult {
-  double timestamp = 0.0; ///< seconds
-  Eigen::Matrix4d T_world_curr =
-      Eigen::Matrix4d::Identity(); ///< camera pose (camera-to-world)
+  double timestamp = 0.0; ///< seconds (the colour image's stamp)
+  /// camera pose at `timestamp` (camera-to-world). The 3D points, hence the fits, belong to
+  /// the depth image's instant; when its stamp differs (TUM fr1: by up to 17 ms either way),
+  /// the pose is carried to `timestamp` along the step from the previous frame's depth
+  /// instant (docs/algorithm.md §7.4)
+  Eigen::Matrix4d T_world_curr = Eigen::Matrix4d::Identity();
   Eigen::Matrix4d T_curr_prev =
       Eigen::Matrix4d::Identity(); ///< ego-motion H_k (identity at frame 0)
   /// no ego-motion (too few static cells, or a bad frame: see error); T_curr_prev is then
@@ -125,7 +129,7 @@ struct FrameResult {
  * dynvo::app::OdometryPipeline pipeline(options);
  * dynvo::Frame frame;
  * while (source.next(frame)) {
- *   const auto& result = pipeline.process(frame.cloud, frame.timestamp);
+ *   const auto& result = pipeline.process(frame.cloud, frame.timestamp, frame.depth_timestamp);
  *   std::cout << result.T_world_curr << (result.lost ? " (lost)" : "") << "\n";
  * }
  * \endcode
@@ -140,12 +144,15 @@ public:
 
   /** \brief Processes the next frame of the sequence.
    * \param[in] cloud organized frame (metres, NaN where no depth), same size every frame
-   * \param[in] timestamp seconds
+   * \param[in] timestamp seconds, the colour image's stamp (the stamp of the pose)
+   * \param[in] depth_timestamp seconds, the depth image's stamp; NaN (the default): the same
    * \return the frame's result, valid until the next call; a bad frame gives a lost result
    *         with FrameResult::error set (see the class doc)
    */
-  const FrameResult& process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& cloud,
-                             double timestamp);
+  const FrameResult&
+  process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& cloud,
+          double timestamp,
+          double depth_timestamp = std::numeric_limits<double>::quiet_NaN());
 
   /// Forgets the sequence: the next frame becomes frame 0 again.
   void reset();

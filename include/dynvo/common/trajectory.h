@@ -20,8 +20,15 @@ struct StampedPose {
 /// Poses in time order (strictly increasing stamps when read from a file).
 using Trajectory = std::vector<StampedPose>;
 
+/** \brief The pose a share x of the way from a to b: linear in translation, slerp in rotation.
+ * x in [0, 1] interpolates; x outside it extrapolates along the same motion (x = 2 repeats
+ * the step from a to b once more).
+ */
+DYNVO_EXPORTS Eigen::Isometry3d
+blendPose(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, double x);
+
 /** \brief Camera-to-world at `stamp`, interpolated between the two poses around it
- * (linear in translation, slerp in rotation).
+ * (blendPose()).
  *
  * When the stamp lies outside the trajectory, or the two poses around it are more than
  * max_gap apart, only a pose exactly at `stamp` is returned.

@@ -18,7 +18,9 @@ namespace dynvo {
 /** \brief One RGB-D frame as delivered by a FrameSource. */
 struct Frame {
   double timestamp = 0.0; ///< seconds; the colour image's stamp
-  std::string name;       ///< where the frame came from (file name), for messages
+  /// seconds; the depth image's stamp (= timestamp for sources with one stamp per frame)
+  double depth_timestamp = 0.0;
+  std::string name; ///< where the frame came from (file name), for messages
   pcl::PointCloud<pcl::PointXYZRGB>::Ptr
       cloud;        ///< organized, current camera frame (metres), NaN where no depth
   ColorImage color; ///< the colour image the cloud was made from

@@ -35,11 +35,9 @@ struct ObjectState {
 
 /// One rendered frame with its ground truth.
 struct SynthFrame {
-  double timestamp = 0.0; ///< seconds (colour stamp)
-  double depth_timestamp =
-      0.0;          ///< seconds (depth stamp, a few ms after the colour one)
-  ColorImage color; ///< shaded, textured colour image
-  DepthImage depth; ///< metres after the depth model; NaN = no measurement
+  double timestamp = 0.0; ///< seconds (the colour and the depth image's stamp)
+  ColorImage color;       ///< shaded, textured colour image
+  DepthImage depth;       ///< metres after the depth model; NaN = no measurement
   std::vector<std::uint8_t>
       labels; ///< per pixel: 0 static, k for object k while it moves
   Eigen::Isometry3d T_world_camera = Eigen::Isometry3d::Identity(); ///< camera-to-world
@@ -107,9 +105,11 @@ struct DYNVO_EXPORTS SynthOptions {
  * BLUR_SAMPLES (7) instants inside their pixel rectangle. Depth and labels show the
  * frame's instant.
  *
- * Timestamps: colour stamp FIRST_STAMP + k / fps, depth stamp DEPTH_STAMP_DELAY later,
- * both rounded to whole microseconds (the "%.6f" of the files parses back exactly);
- * the depth image shows the scene at the colour stamp (a synchronised, registered sensor).
+ * Timestamps: FIRST_STAMP + k / fps, rounded to whole microseconds (the "%.6f" of the
+ * files parses back exactly), one stamp for colour and depth: both images show the scene
+ * at that instant (a synchronised, registered sensor). A depth stamp that differed would
+ * tell the odometry, which reports the pose at the colour stamp, that the depth was taken
+ * at another instant (docs/algorithm.md §7.4).
  *
  * \code
  * dynvo::SynthOptions options;
@@ -120,9 +120,8 @@ struct DYNVO_EXPORTS SynthOptions {
  */
 class DYNVO_EXPORTS SceneSynthesizer {
 public:
-  static constexpr double FIRST_STAMP = 1.0;         ///< colour stamp of frame 0 (s)
-  static constexpr double DEPTH_STAMP_DELAY = 0.005; ///< depth stamp - colour stamp (s)
-  static constexpr double DEPTH_PNG_SCALE = 5000.0;  ///< depth PNG units per metre
+  static constexpr double FIRST_STAMP = 1.0;        ///< colour stamp of frame 0 (s)
+  static constexpr double DEPTH_PNG_SCALE = 5000.0; ///< depth PNG units per metre
 
   /// \throws std::invalid_argument when options.validate() fails
   explicit SceneSynthesizer(const SynthOptions& options);
