@@ -8,6 +8,7 @@
 #include <pcl/console/print.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -77,6 +78,7 @@ SegmentTracker::reset()
   separated_.clear();
   ids_.clear();
   motions_.clear();
+  ages_.clear();
 }
 
 std::vector<std::uint8_t>
@@ -477,6 +479,40 @@ SegmentTracker::collectOutputs(const GridFlowData& grid,
 }
 
 void
+SegmentTracker::updateAges(const GridFlowData& grid, bool first_pair)
+{
+  constexpr int OLD = std::numeric_limits<int>::max();
+  ages_.resize(256, 0);
+  std::vector<char> measured(256, 0);
+  for (const std::uint8_t id : tracked_)
+    measured[id] = 1;
+  const std::vector<std::uint8_t> previous =
+      previous_fused_.size() == grid.size() ? warpNearest(previous_fused_, grid)
+                                            : std::vector<std::uint8_t>(grid.size(), 0);
+  std::vector<int> next(256, 0);
+  for (const std::uint8_t id : ids_) {
+    if (id == LABEL_STATIC)
+      continue;
+    int age = first_pair ? OLD : ages_[id];
+    if (age == 0) {
+      // A new id over cells that mostly held one object: that object under a new id.
+      std::array<int, 256> held{};
+      int cells = 0;
+      for (std::size_t i = 0; i < grid.size(); ++i)
+        if (fused_[i] == id) {
+          ++cells;
+          ++held[previous[i]];
+        }
+      const auto most = std::max_element(held.begin() + LABEL_STATIC + 1, held.end());
+      if (2 * *most >= cells)
+        age = ages_[most - held.begin()];
+    }
+    next[id] = age == OLD ? OLD : age + (measured[id] ? 1 : 0);
+  }
+  ages_ = std::move(next);
+}
+
+void
 SegmentTracker::update(const GridFlowData& grid,
                        const SpatialSegmentationResult& spatial,
                        const Eigen::Matrix4d& T_pred,
@@ -492,6 +528,7 @@ SegmentTracker::update(const GridFlowData& grid,
     model_.reset(grid.cols(), grid.rows(), params.max_labels);
   }
   collectUsedIds(params.max_labels);
+  const bool first_pair = !hasHistory();
   for (auto& map : buffer_)
     map = warpNearest(map, grid);
 
@@ -520,6 +557,7 @@ SegmentTracker::update(const GridFlowData& grid,
   model_.update(tracked_, params.max_age);
 
   collectOutputs(grid, spatial, ids, T_pred);
+  updateAges(grid, first_pair);
   previous_fused_ = fused_;
   buffer_.push_front(tracked_);
   while (static_cast<int>(buffer_.size()) > params.buffer_length)

@@ -15,6 +15,7 @@
 #include <array>
 #include <numeric>
 #include <random>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -272,13 +273,87 @@ TEST_F(BoxSequence, BoxCoveringMostOfTheImageDoesNotTakeTheBackgroundLabel)
   EXPECT_TRUE(segmentation.getMotions()[0].isIdentity(1e-4f));
 }
 
+/// Segments frame k of a box (8 x 14 cells at 1.2 m from column col0, 160 x 120, 4 px cells)
+/// moving `step` metres along x before a static background, with flow noise 0.5 mm per axis
+/// (a new draw every frame); returns the segments and the true label of each cell.
+std::pair<std::vector<pcl::PointIndices>, std::vector<int>>
+segmentBoxFrame(dynvo::RigidMotionSegmentation<pcl::PointXYZRGB>& segmentation,
+                int col0,
+                double step,
+                std::size_t k)
+{
+  constexpr int CELL = 4;
+  const auto synthetic = dynvo::test::makeSyntheticFlow(
+      40, 30, CELL, dynvo::test::intrinsicsFor(160), Eigen::Matrix4d::Identity(),
+      {{col0, 8, col0 + 8, 22, 1.2,
+        dynvo::test::makeMotion({0, 0, 1}, 0.0, {step, 0.0, 0.0}), 2}},
+      5e-4, static_cast<std::uint32_t>(k + 1));
+  segmentation.setInputCloud(
+      dynvo::test::cloudFromFlow<pcl::PointXYZRGB>(*synthetic.flow, CELL));
+  segmentation.setInputFlow(synthetic.flow);
+  std::vector<pcl::PointIndices> segments;
+  segmentation.segment(segments);
+  return {segments, synthetic.truth};
+}
+
+/// Output ids per frame while the box of segmentBoxFrame() (from column 4) moves 4 cm per
+/// frame along x in the frames where `moving` is set and stands still (part of the
+/// background) in the others; also checks that its cells stay out of the fit's static set
+/// while it moves.
+std::vector<std::vector<std::uint8_t>>
+newObjectOutputs(const std::vector<bool>& moving, int birth_frames)
+{
+  dynvo::RigidMotionSegmentation<pcl::PointXYZRGB> segmentation;
+  segmentation.setCameraIntrinsics(dynvo::test::intrinsicsFor(160));
+  segmentation.setObjectBirthFrames(birth_frames);
+  std::vector<std::vector<std::uint8_t>> outputs;
+  for (std::size_t k = 0; k < moving.size(); ++k) {
+    const auto [segments, truth] =
+        segmentBoxFrame(segmentation, 4, moving[k] ? 0.04 : 0.0, k);
+    EXPECT_EQ(segments.size(), segmentation.getSegmentLabels().size());
+    if (moving[k])
+      for (std::size_t i = 0; i < truth.size(); ++i)
+        if (truth[i] == 2)
+          EXPECT_NE(segmentation.getCellLabels()[i], 1) << "frame " << k << " cell " << i;
+    outputs.push_back(segmentation.getSegmentLabels());
+  }
+  return outputs;
+}
+
+TEST(ObjectBirth, NewObjectIsOutputFromItsThirdFrame)
+{
+  // Still for 3 frames, then moving: the motion is measured from frame 3 on (4 cm per
+  // frame against 0.5 mm of flow noise), so the box is a new object
+  // there; it is output from its third consecutive frame, frame 5, and kept out of the
+  // ego-motion fit from frame 3.
+  const std::vector<bool> moving{false, false, false, true, true, true, true};
+  const auto held = newObjectOutputs(moving, 3);
+  for (int k = 0; k < 5; ++k)
+    EXPECT_EQ(held[k], (std::vector<std::uint8_t>{1})) << "frame " << k;
+  for (int k = 5; k < 7; ++k)
+    EXPECT_EQ(held[k], (std::vector<std::uint8_t>{1, 2})) << "frame " << k;
+  // object_birth_frames 1: output as soon as it is measured.
+  const auto immediate = newObjectOutputs(moving, 1);
+  EXPECT_EQ(immediate[2], (std::vector<std::uint8_t>{1}));
+  EXPECT_EQ(immediate[3], (std::vector<std::uint8_t>{1, 2}));
+}
+
+TEST(ObjectBirth, ObjectOfTwoFramesIsNeverOutput)
+{
+  // Two frames of motion, as the spurious objects of a real static scene (most last one to
+  // three frames): never among the outputs, and out of the fit while it lasts.
+  const auto outputs =
+      newObjectOutputs({false, false, false, true, true, false, false, false}, 3);
+  for (std::size_t k = 0; k < outputs.size(); ++k)
+    EXPECT_EQ(outputs[k], (std::vector<std::uint8_t>{1})) << "frame " << k;
+}
+
 /// Majority output label over the box's cells while a box (8 x 14 cells at 1.2 m) moves by
 /// `steps[k]` metres along x in frame k: one cell column per frame while fast (4 cm at 1.2 m is
 /// 4.4 px), in place when slow. Flow noise 0.5 mm per axis, a new draw every frame.
 std::vector<int>
 boxLabels(const std::vector<double>& steps, float separation_ratio, float hold = 1.15f)
 {
-  constexpr int CELL = 4;
   dynvo::RigidMotionSegmentation<pcl::PointXYZRGB> segmentation;
   segmentation.setCameraIntrinsics(dynvo::test::intrinsicsFor(160));
   segmentation.setObjectSeparationRatio(separation_ratio);
@@ -288,19 +363,10 @@ boxLabels(const std::vector<double>& steps, float separation_ratio, float hold =
   int col0 = 4;
   for (std::size_t k = 0; k < steps.size(); ++k) {
     col0 += steps[k] >= 0.02 ? 1 : 0;
-    const auto synthetic = dynvo::test::makeSyntheticFlow(
-        40, 30, CELL, dynvo::test::intrinsicsFor(160), Eigen::Matrix4d::Identity(),
-        {{col0, 8, col0 + 8, 22, 1.2,
-          dynvo::test::makeMotion({0, 0, 1}, 0.0, {steps[k], 0.0, 0.0}), 2}},
-        5e-4, static_cast<std::uint32_t>(k + 1));
-    segmentation.setInputCloud(
-        dynvo::test::cloudFromFlow<pcl::PointXYZRGB>(*synthetic.flow, CELL));
-    segmentation.setInputFlow(synthetic.flow);
-    std::vector<pcl::PointIndices> segments;
-    segmentation.segment(segments);
+    const std::vector<int> truth = segmentBoxFrame(segmentation, col0, steps[k], k).second;
     std::array<int, 256> votes{};
-    for (std::size_t i = 0; i < synthetic.truth.size(); ++i)
-      if (synthetic.truth[i] == 2)
+    for (std::size_t i = 0; i < truth.size(); ++i)
+      if (truth[i] == 2)
         ++votes[segmentation.getCellLabels()[i]];
     labels.push_back(
         static_cast<int>(std::max_element(votes.begin(), votes.end()) - votes.begin()));

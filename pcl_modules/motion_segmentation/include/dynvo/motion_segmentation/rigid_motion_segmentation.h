@@ -124,11 +124,15 @@ public:
   /// T_curr_prev of each segment of the last segment() (maps frame k-1 points to frame k).
   const Motions& getMotions() const { return motions_; }
 
-  /// Output label per grid cell (row-major, cols x rows of the flow): 0 none, 1 static, 2.. objects.
+  /** \brief Label per grid cell (row-major, cols x rows of the flow): 0 none, 1 static, 2..
+   * objects, the cells the ego-motion fit takes as static being those labelled 1. An object
+   * younger than object_birth_frames is here but not yet in the segments, the pixel labels or
+   * getSegmentLabels() (its pixels are static there).
+   */
   const std::vector<std::uint8_t>& getCellLabels() const { return cell_grid_.labels; }
 
-  /// The grid of the last segment() with the output label of each cell (getCellLabels());
-  /// empty when the inputs broke the contract.
+  /// The grid of the last segment() with the label of each cell (getCellLabels()); empty
+  /// when the inputs broke the contract.
   const FlowGrid& getCellGrid() const { return cell_grid_; }
 
   /// The two-frame segmentation of the last segment() (G, one motion per segment, docs/algorithm.md §3).
@@ -204,6 +208,7 @@ public:
   DYNVO_PARAMETER_ACCESSORS(StaticMinCells, static_min_cells)
   DYNVO_PARAMETER_ACCESSORS(ObjectSeparationRatio, object_separation_ratio)
   DYNVO_PARAMETER_ACCESSORS(ObjectSeparationHold, object_separation_hold)
+  DYNVO_PARAMETER_ACCESSORS(ObjectBirthFrames, object_birth_frames)
   DYNVO_PARAMETER_ACCESSORS(Seed, seed)
 
 protected:
@@ -250,7 +255,8 @@ private:
   SpatialSegmenter segmenter_;               ///< §3 with its scratch buffers
   SpatialSegmentationResult spatial_;        ///< §3 result of the last frame
   SegmentTracker tracker_;                   ///< §4-§6 state across frames
-  FlowGrid cell_grid_;                       ///< geometry and output label per cell
+  FlowGrid cell_grid_;                       ///< geometry and label per cell (the fit's)
+  FlowGrid output_grid_; ///< cell_grid_ with objects younger than n_birth static
   std::vector<std::uint8_t> segment_labels_; ///< id of each output segment
   Motions motions_;                          ///< T_curr_prev of each output segment
   PixelLabelRefinement refinement_;          ///< cell labels to pixel labels

@@ -70,6 +70,14 @@ public:
   /// Fused output label per cell (see the class doc).
   const std::vector<std::uint8_t>& labels() const { return fused_; }
 
+  /** \brief Frames in which `id` was measured (in trackedLabels()) since it appeared among
+   * ids() without a break (frames in which only the model holds it do not count); an id
+   * that appears over cells that mostly held one object in the previous frame continues
+   * that object's count (the object under a new id). std::numeric_limits<int>::max() for the
+   * objects of a sequence's first pair (the start-up assumption) and those continuing them.
+   */
+  int age(std::uint8_t id) const { return ages_.empty() ? 0 : ages_[id]; }
+
   /// Output ids: 1 first, then every object id present in labels(), ascending.
   const std::vector<std::uint8_t>& ids() const { return ids_; }
 
@@ -140,6 +148,9 @@ private:
                         const SpatialSegmentationResult& spatial,
                         const std::vector<int>& ids,
                         const RigidMotionSegmentationParameters& params);
+  /// ages_ after this frame's outputs (see age()).
+  void updateAges(const GridFlowData& grid, bool first_pair);
+
   /// Output ids and one motion per id.
   void collectOutputs(const GridFlowData& grid,
                       const SpatialSegmentationResult& spatial,
@@ -158,6 +169,7 @@ private:
   std::vector<std::uint8_t> ids_; ///< output ids
   std::vector<Eigen::Matrix4d> motions_; ///< motion per output id
   std::vector<char> used_;               ///< ids taken at the start of the frame
+  std::vector<int> ages_;                ///< per id: see age()
 };
 
 } // namespace dynvo

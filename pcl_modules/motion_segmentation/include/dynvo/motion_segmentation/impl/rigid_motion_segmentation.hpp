@@ -80,6 +80,7 @@ void
 RigidMotionSegmentation<PointT>::clearOutputs()
 {
   cell_grid_ = FlowGrid();
+  output_grid_ = FlowGrid();
   segment_labels_.clear();
   motions_.clear();
   spatial_ = SpatialSegmentationResult();
@@ -138,7 +139,7 @@ RigidMotionSegmentation<PointT>::computeImplPixelLabels()
   const std::uint32_t* rgba = nullptr;
   if constexpr (pcl::traits::has_color<PointT>::value)
     rgba = &(*input_)[0].rgba;
-  refinement_.refine(cell_grid_, fallback, &(*input_)[0].z, rgba, stride,
+  refinement_.refine(output_grid_, fallback, &(*input_)[0].z, rgba, stride,
                      pixel_labels_);
 }
 
@@ -217,9 +218,20 @@ RigidMotionSegmentation<PointT>::segment(std::vector<pcl::PointIndices>& segment
     tracker_.update(grid_, spatial_, predicted_motion_.cast<double>(), intrinsics_,
                     params_);
     cell_grid_.labels = tracker_.labels();
-    segment_labels_ = tracker_.ids();
-    for (const Eigen::Matrix4d& H : tracker_.motions())
-      motions_.push_back(H.cast<float>());
+    // [D] Objects younger than n_birth frames are not output yet: most spurious objects of
+    // a real static scene last one to three frames.
+    std::array<bool, 256> young{};
+    for (std::size_t s = 0; s < tracker_.ids().size(); ++s) {
+      const std::uint8_t id = tracker_.ids()[s];
+      young[id] = id != LABEL_STATIC && tracker_.age(id) < params_.object_birth_frames;
+      if (young[id])
+        continue;
+      segment_labels_.push_back(id);
+      motions_.push_back(tracker_.motions()[s].cast<float>());
+    }
+    output_grid_ = cell_grid_;
+    for (std::uint8_t& label : output_grid_.labels)
+      label = young[label] ? LABEL_STATIC : label;
   }
   else {
     // Two-frame result: segments by size, the largest taken as the background.
@@ -231,6 +243,7 @@ RigidMotionSegmentation<PointT>::segment(std::vector<pcl::PointIndices>& segment
       segment_labels_.push_back(static_cast<std::uint8_t>(c));
       motions_.push_back(spatial_.motions[c - 1].cast<float>());
     }
+    output_grid_ = cell_grid_;
   }
   updateNoiseScale();
   computeImplPixelLabels();
