@@ -478,8 +478,28 @@ SegmentTracker::collectOutputs(const GridFlowData& grid,
   }
 }
 
+bool
+SegmentTracker::clearlyApart(const GridFlowData& grid, std::uint8_t id, double ratio) const
+{
+  const auto at = std::find(ids_.begin(), ids_.end(), id);
+  const Eigen::Matrix4d& H_object = motions_[at - ids_.begin()];
+  const Eigen::Matrix4d& H_background = motions_.front();
+  double e_background = 0.0, e_object = 0.0;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < grid.size(); ++i)
+    if (fused_[i] == id && grid.valid_3d[i]) {
+      const Eigen::Vector3d a = grid.a[i].cast<double>(), b = grid.b[i].cast<double>();
+      e_background += squaredTransferError(H_background, a, b);
+      e_object += squaredTransferError(H_object, a, b);
+      ++n;
+    }
+  // The object's motion was fitted on these cells: 6 degrees of freedom of their residual.
+  return n > 6 && e_background > ratio * ratio * e_object * static_cast<double>(n) /
+                                     static_cast<double>(n - 6);
+}
+
 void
-SegmentTracker::updateAges(const GridFlowData& grid, bool first_pair)
+SegmentTracker::updateAges(const GridFlowData& grid, bool first_pair, double separation_ratio)
 {
   constexpr int OLD = std::numeric_limits<int>::max();
   ages_.resize(256, 0);
@@ -507,6 +527,9 @@ SegmentTracker::updateAges(const GridFlowData& grid, bool first_pair)
       if (2 * *most >= cells)
         age = ages_[most - held.begin()];
     }
+    if (age != OLD && measured[id] && separation_ratio > 0.0 &&
+        clearlyApart(grid, id, separation_ratio))
+      age = OLD;
     next[id] = age == OLD ? OLD : age + (measured[id] ? 1 : 0);
   }
   ages_ = std::move(next);
@@ -557,7 +580,7 @@ SegmentTracker::update(const GridFlowData& grid,
   model_.update(tracked_, params.max_age);
 
   collectOutputs(grid, spatial, ids, T_pred);
-  updateAges(grid, first_pair);
+  updateAges(grid, first_pair, params.object_birth_ratio);
   previous_fused_ = fused_;
   buffer_.push_front(tracked_);
   while (static_cast<int>(buffer_.size()) > params.buffer_length)

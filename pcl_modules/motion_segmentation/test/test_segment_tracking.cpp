@@ -301,11 +301,12 @@ segmentBoxFrame(dynvo::RigidMotionSegmentation<pcl::PointXYZRGB>& segmentation,
 /// background) in the others; also checks that its cells stay out of the fit's static set
 /// while it moves.
 std::vector<std::vector<std::uint8_t>>
-newObjectOutputs(const std::vector<bool>& moving, int birth_frames)
+newObjectOutputs(const std::vector<bool>& moving, int birth_frames, float birth_ratio)
 {
   dynvo::RigidMotionSegmentation<pcl::PointXYZRGB> segmentation;
   segmentation.setCameraIntrinsics(dynvo::test::intrinsicsFor(160));
   segmentation.setObjectBirthFrames(birth_frames);
+  segmentation.setObjectBirthRatio(birth_ratio);
   std::vector<std::vector<std::uint8_t>> outputs;
   for (std::size_t k = 0; k < moving.size(); ++k) {
     const auto [segments, truth] =
@@ -323,19 +324,25 @@ newObjectOutputs(const std::vector<bool>& moving, int birth_frames)
 TEST(ObjectBirth, NewObjectIsOutputFromItsThirdFrame)
 {
   // Still for 3 frames, then moving: the motion is measured from frame 3 on (4 cm per
-  // frame against 0.5 mm of flow noise), so the box is a new object
-  // there; it is output from its third consecutive frame, frame 5, and kept out of the
-  // ego-motion fit from frame 3.
+  // frame against 0.5 mm of flow noise), so the box is a new object there. Without the
+  // ratio exemption it is output from its third consecutive frame, frame 5, and kept out
+  // of the ego-motion fit from frame 3.
   const std::vector<bool> moving{false, false, false, true, true, true, true};
-  const auto held = newObjectOutputs(moving, 3);
+  const auto held = newObjectOutputs(moving, 3, 0.0f);
   for (int k = 0; k < 5; ++k)
     EXPECT_EQ(held[k], (std::vector<std::uint8_t>{1})) << "frame " << k;
   for (int k = 5; k < 7; ++k)
     EXPECT_EQ(held[k], (std::vector<std::uint8_t>{1, 2})) << "frame " << k;
   // object_birth_frames 1: output as soon as it is measured.
-  const auto immediate = newObjectOutputs(moving, 1);
+  const auto immediate = newObjectOutputs(moving, 1, 0.0f);
   EXPECT_EQ(immediate[2], (std::vector<std::uint8_t>{1}));
   EXPECT_EQ(immediate[3], (std::vector<std::uint8_t>{1, 2}));
+  // Defaults (3 frames, ratio 5): its cells fit the background's motion about 46 times
+  // worse (RMS: sqrt(40^2 + 0.75) / sqrt(0.75) mm) than their own, so it is output at once.
+  const auto apart = newObjectOutputs(moving, 3, 5.0f);
+  EXPECT_EQ(apart[2], (std::vector<std::uint8_t>{1}));
+  for (int k = 3; k < 7; ++k)
+    EXPECT_EQ(apart[k], (std::vector<std::uint8_t>{1, 2})) << "frame " << k;
 }
 
 TEST(ObjectBirth, ObjectOfTwoFramesIsNeverOutput)
@@ -343,7 +350,7 @@ TEST(ObjectBirth, ObjectOfTwoFramesIsNeverOutput)
   // Two frames of motion, as the spurious objects of a real static scene (most last one to
   // three frames): never among the outputs, and out of the fit while it lasts.
   const auto outputs =
-      newObjectOutputs({false, false, false, true, true, false, false, false}, 3);
+      newObjectOutputs({false, false, false, true, true, false, false, false}, 3, 0.0f);
   for (std::size_t k = 0; k < outputs.size(); ++k)
     EXPECT_EQ(outputs[k], (std::vector<std::uint8_t>{1})) << "frame " << k;
 }

@@ -209,6 +209,7 @@ public:
   DYNVO_PARAMETER_ACCESSORS(ObjectSeparationRatio, object_separation_ratio)
   DYNVO_PARAMETER_ACCESSORS(ObjectSeparationHold, object_separation_hold)
   DYNVO_PARAMETER_ACCESSORS(ObjectBirthFrames, object_birth_frames)
+  DYNVO_PARAMETER_ACCESSORS(ObjectBirthRatio, object_birth_ratio)
   DYNVO_PARAMETER_ACCESSORS(Seed, seed)
 
 protected:

@@ -74,7 +74,8 @@ public:
    * ids() without a break (frames in which only the model holds it do not count); an id
    * that appears over cells that mostly held one object in the previous frame continues
    * that object's count (the object under a new id). std::numeric_limits<int>::max() for the
-   * objects of a sequence's first pair (the start-up assumption) and those continuing them.
+   * objects of a sequence's first pair (the start-up assumption), those continuing them, and
+   * those measured clearly apart from the background (object_birth_ratio, clearlyApart()).
    */
   int age(std::uint8_t id) const { return ages_.empty() ? 0 : ages_[id]; }
 
@@ -149,7 +150,11 @@ private:
                         const std::vector<int>& ids,
                         const RigidMotionSegmentationParameters& params);
   /// ages_ after this frame's outputs (see age()).
-  void updateAges(const GridFlowData& grid, bool first_pair);
+  void updateAges(const GridFlowData& grid, bool first_pair, double separation_ratio);
+
+  /// The cells of output id `id` fit the background's motion `ratio` times worse (RMS) than
+  /// the id's own motion (discounted by its fit's 6 degrees of freedom).
+  bool clearlyApart(const GridFlowData& grid, std::uint8_t id, double ratio) const;
 
   /// Output ids and one motion per id.
   void collectOutputs(const GridFlowData& grid,
