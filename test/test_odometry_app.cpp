@@ -2,6 +2,7 @@
 // dynvo_odometry as users run it: outputs, closing lines, determinism and bad input.
 #include <dynvo/app/object_trajectories.h>
 #include <dynvo/app/pipeline_config.h>
+#include <dynvo/io/image_io.h>
 #include <dynvo/io/label_io.h>
 #include <dynvo/io/trajectory_io.h>
 
@@ -35,6 +36,18 @@ protected:
   }
 
   static void TearDownTestSuite() { delete sequence_; }
+
+  /// Copies the sequence to out_/seq and returns the images of one of its folders ("rgb",
+  /// "depth") in frame order, for a test to spoil one.
+  std::vector<fs::path> copySequence(const std::string& folder) const
+  {
+    fs::copy(sequence_->path(), out_.file("seq"), fs::copy_options::recursive);
+    std::vector<fs::path> images;
+    for (const auto& entry : fs::directory_iterator(out_.file("seq") + "/" + folder))
+      images.push_back(entry.path());
+    std::sort(images.begin(), images.end());
+    return images;
+  }
 
   std::string run(const std::string& flags) const
   {
@@ -159,11 +172,7 @@ TEST_F(OdometryApp, WrittenConfigReproducesTheRunForEveryField)
 TEST_F(OdometryApp, CorruptFrameStopsTheRunButKeepsWhatWasComputed)
 {
   // Copy the sequence and corrupt the colour image of frame 6.
-  fs::copy(sequence_->path(), out_.file("seq"), fs::copy_options::recursive);
-  std::vector<fs::path> colour;
-  for (const auto& entry : fs::directory_iterator(out_.file("seq") + "/rgb"))
-    colour.push_back(entry.path());
-  std::sort(colour.begin(), colour.end());
+  const std::vector<fs::path> colour = copySequence("rgb");
   dynvo::test::writeText(colour[6].string(), "not a png");
   const auto result = runCommand(app_ + " -tum_dir " + out_.file("seq") + " -out " +
                                  out_.file("t.txt"));
@@ -171,6 +180,62 @@ TEST_F(OdometryApp, CorruptFrameStopsTheRunButKeepsWhatWasComputed)
   EXPECT_NE(result.err.find(colour[6].filename().string()), std::string::npos)
       << result.err;
   EXPECT_EQ(dynvo::readTrajectory(out_.file("t.txt")).size(), 6u);
+}
+
+TEST_F(OdometryApp, FramesReportSaysWhichFramesWereLostAndWhy)
+{
+  // Frame 10 of a copy has no depth at all: no static cell can be measured into it or out
+  // of it, so it is lost for want of static cells; every other frame of this static camera
+  // is registered, the one after against the keyframe kept before the empty frame.
+  const std::vector<fs::path> depth = copySequence("depth");
+  auto empty = dynvo::readRawDepthImage(depth[10].string());
+  std::fill(empty.data.begin(), empty.data.end(), 0);
+  dynvo::writeRawDepthImage(depth[10].string(), empty);
+  const auto result =
+      runCommand(app_ + " -tum_dir " + out_.file("seq") + " -out " +
+                 out_.file("t.txt") + " -frames_report " + out_.file("frames.tsv"));
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  std::istringstream report(dynvo::test::readText(out_.file("frames.tsv")));
+  std::string line;
+  ASSERT_TRUE(std::getline(report, line));
+  EXPECT_EQ(line,
+            "# stamp\tlost\treason\tstatic_cells\tresidual_m2\tkeyframe\t"
+            "moving_share\tscene_flow_ms\tsegmentation_ms\tregistration_ms\ttotal_ms");
+  const auto trajectory = dynvo::readTrajectory(out_.file("t.txt"));
+  std::vector<std::vector<std::string>> rows;
+  while (std::getline(report, line)) {
+    std::vector<std::string> columns;
+    std::istringstream fields(line);
+    for (std::string field; std::getline(fields, field, '\t');)
+      columns.push_back(field);
+    ASSERT_EQ(columns.size(), 11u) << line;
+    rows.push_back(columns);
+  }
+  ASSERT_EQ(rows.size(), static_cast<std::size_t>(FRAMES));
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    EXPECT_NEAR(std::stod(rows[k][0]), trajectory[k].timestamp, 1e-6) << "frame " << k;
+    const bool lost = k == 10;
+    EXPECT_EQ(rows[k][1], lost ? "1" : "0") << "frame " << k;
+    EXPECT_EQ(rows[k][2], lost ? "too_few_static_cells" : "none") << "frame " << k;
+    // A registered frame rests on hundreds of the 1200 cells (a 640x480 grid of 16 px),
+    // with a residual of millimetres squared; frame 0 has no fit, frame 1 becomes the
+    // first keyframe and is measured frame to frame.
+    if (k > 0 && !lost) {
+      EXPECT_GT(std::stoul(rows[k][3]), 100u) << "frame " << k;
+      EXPECT_GT(std::stod(rows[k][4]), 0.0) << "frame " << k;
+      EXPECT_LT(std::stod(rows[k][4]), 1e-4) << "frame " << k;
+      EXPECT_GE(std::stol(rows[k][5]), k > 1 ? 1 : -1) << "frame " << k;
+    }
+    const double share = std::stod(rows[k][6]);
+    EXPECT_GE(share, 0.0);
+    EXPECT_LE(share, 1.0);
+    for (int column = 7; column < 11; ++column)
+      EXPECT_GE(std::stod(rows[k][column]), 0.0) << "frame " << k;
+  }
+  // Frame 11 has no flow into the empty frame: its pose comes from a keyframe before it.
+  EXPECT_GE(std::stol(rows[11][5]), 1);
+  EXPECT_LE(std::stol(rows[11][5]), 9);
+  EXPECT_FALSE(fs::exists(out_.file("frames.tsv.partial")));
 }
 
 TEST_F(OdometryApp, CloudsAreLabelledPcdsOfEveryNthFrame)

@@ -223,6 +223,60 @@ TEST(OdometryPipeline, FrameAfterALostOneIsRecoveredAgainstTheKeyframe)
   EXPECT_LT(error(run, 19), error(frame_to_frame, 19));
 }
 
+TEST(OdometryPipeline, OccluderOverNearlyTheWholeImageNeverDerailsThePose)
+{
+  // Frames 20-49 (1 s): a textured board 0.8 m from the camera covers all but the right
+  // 5 % of the image and slides 6 px per frame, so the flow is dominated by a coherent
+  // motion that is not the camera's (a person passing close to a hand-held camera).
+  constexpr int first = 20;
+  constexpr int last = 49;
+  constexpr int frames = 80;
+  const auto occluder = [&](int k, dynvo::ColorImage& color, dynvo::DepthImage& depth) {
+    if (k < first || k > last)
+      return;
+    const std::uint32_t covered = depth.width - depth.width / 20;
+    for (std::uint32_t v = 0; v < depth.height; ++v)
+      for (std::uint32_t u = 0; u < covered; ++u) {
+        const std::uint32_t block =
+            ((u + 6u * static_cast<std::uint32_t>(k)) / 8u) * 7919u +
+            (v / 8u) * 104729u;
+        const auto grey =
+            static_cast<std::uint8_t>(40u + (block * 2654435761u >> 24) % 180u);
+        const std::size_t i = static_cast<std::size_t>(v) * depth.width + u;
+        std::fill_n(color.data.begin() + 3 * i, 3, grey);
+        depth.data[i] = 0.8f;
+      }
+  };
+  const SequenceRun run = runScenario("moving_static", frames, 1, occluder);
+  const dynvo::app::PipelineOptions defaults;
+  for (std::size_t k = 1; k < run.estimate.size(); ++k) {
+    const Eigen::Isometry3d step =
+        run.estimate[k - 1].T_world_camera.inverse() * run.estimate[k].T_world_camera;
+    ASSERT_TRUE(step.matrix().allFinite()) << "frame " << k;
+    // Every step within the physical bound (1 % for the pose's rounding to the colour
+    // stamp, which blends two bounded steps).
+    const double dt = run.estimate[k].timestamp - run.estimate[k - 1].timestamp;
+    EXPECT_LE(step.translation().norm(), 1.01 * defaults.max_speed * dt)
+        << "frame " << k;
+    EXPECT_LE(Eigen::AngleAxisd(step.linear()).angle(),
+              1.01 * defaults.max_rotation_rate * dt)
+        << "frame " << k;
+  }
+  // Over the occluded second the camera follows the board (18 cm at the end, measured
+  // 2026-12-04: 95 % of the cells move coherently and within the motion guard of the
+  // prediction), but tracking resumes once the board has gone: the frames after it are registered, and each step matches the true one within
+  // 3 mm (registered steps of this room are within about 1 mm; src/app/NOTES.md).
+  for (int k = last + 3; k < frames; ++k) {
+    EXPECT_FALSE(run.lost[k]) << "frame " << k;
+    const Eigen::Isometry3d estimated =
+        run.estimate[k - 1].T_world_camera.inverse() * run.estimate[k].T_world_camera;
+    const Eigen::Isometry3d truth = run.groundtruth[k - 1].T_world_camera.inverse() *
+                                    run.groundtruth[k].T_world_camera;
+    EXPECT_LT((estimated.translation() - truth.translation()).norm(), 0.003)
+        << "frame " << k;
+  }
+}
+
 TEST(OdometryPipeline, PoseIsReportedAtTheColourStamp)
 {
   // Every frame is rendered at one instant t_k. Told that this is the depth image's instant

@@ -42,6 +42,43 @@ orthonormalize(Eigen::Matrix4d& T)
   T.topLeftCorner<3, 3>() = svd.matrixU() * svd.matrixV().transpose();
 }
 
+/** The largest share x in [0, 1] of a camera step T_curr_prev (blendPose(I, T, x)) that
+ * stays within the motion bound over dt seconds; 0 when the step is not finite.
+ */
+double
+shareWithinBound(const Eigen::Matrix4d& T_curr_prev,
+                 double dt,
+                 const PipelineOptions& o)
+{
+  if (!T_curr_prev.allFinite())
+    return 0.0;
+  const double distance = T_curr_prev.topRightCorner<3, 1>().norm();
+  const double angle =
+      Eigen::AngleAxisd(Eigen::Matrix3d(T_curr_prev.topLeftCorner<3, 3>())).angle();
+  double share = 1.0;
+  if (distance > o.max_speed * dt)
+    share = std::min(share, o.max_speed * dt / distance);
+  if (angle > o.max_rotation_rate * dt)
+    share = std::min(share, o.max_rotation_rate * dt / angle);
+  return share;
+}
+
+/// The step T_curr_prev taken x times (blendPose from the identity; x >= 0).
+Eigen::Matrix4d
+scaleStep(const Eigen::Matrix4d& T_curr_prev, double x)
+{
+  return blendPose(Eigen::Isometry3d::Identity(), Eigen::Isometry3d(T_curr_prev), x)
+      .matrix();
+}
+
+LostReason
+lostReasonOf(StaticRegistrationStatus status)
+{
+  return status == StaticRegistrationStatus::degenerate
+             ? LostReason::degenerate
+             : LostReason::too_few_static_cells;
+}
+
 std::string
 sizeText(const Cloud& cloud)
 {
@@ -49,6 +86,24 @@ sizeText(const Cloud& cloud)
 }
 
 } // namespace
+
+const char*
+lostReasonName(LostReason reason)
+{
+  switch (reason) {
+  case LostReason::none:
+    return "none";
+  case LostReason::bad_frame:
+    return "bad_frame";
+  case LostReason::too_few_static_cells:
+    return "too_few_static_cells";
+  case LostReason::degenerate:
+    return "degenerate";
+  case LostReason::beyond_bound:
+    return "beyond_bound";
+  }
+  return "unknown";
+}
 
 PipelineOptions::PipelineOptions()
 {
@@ -112,6 +167,7 @@ struct OdometryPipeline::Impl {
     const auto flow_start = Clock::now();
     flow_estimation.shiftCurrentToPrevious();
     flow_estimation.setInputCloud(cloud);
+    flow_estimation.setPredictedMotion(T_curr_prev_predicted.cast<float>());
     auto flow = pcl::make_shared<pcl::PointCloud<PointFlow>>();
     flow_estimation.compute(*flow);
     result.times.scene_flow_ms = millisecondsSince(flow_start);
@@ -139,9 +195,18 @@ struct OdometryPipeline::Impl {
     registration.setInputTarget(previous);
     registration.setInputFlow(flow);
     selection.setPredictedMotion(T_curr_prev_predicted);
-    result.lost = !selection.align(registration);
-    if (!result.lost)
+    result.lost = true;
+    if (!selection.align(registration))
+      result.lost_reason = lostReasonOf(registration.getStatus());
+    else if (!withinBound(
+                 rigidInverse(registration.getFinalTransformation().cast<double>())))
+      result.lost_reason = LostReason::beyond_bound;
+    else {
+      result.lost = false;
       noise_tracker.addResidual(registration.getMeanSquaredResidual());
+      result.static_cells = registration.getNumberOfInliers();
+      result.residual = registration.getMeanSquaredResidual();
+    }
     result.T_curr_prev =
         result.lost
             ? T_curr_prev_predicted
@@ -177,9 +242,16 @@ struct OdometryPipeline::Impl {
         angle, renew ? ", new keyframe" : "");
     if (renew && !result.lost && flow_estimation.setCurrentAsKeyframe()) {
       T_world_keyframe = result.T_world_curr;
+      keyframe_frame = frames;
       keyframe_inliers = 0;
       result.keyframe = true;
     }
+  }
+
+  /// The step T_curr_prev lies within the motion bound over this frame's step_dt.
+  bool withinBound(const Eigen::Matrix4d& T_curr_prev) const
+  {
+    return shareWithinBound(T_curr_prev, step_dt, options) >= 1.0;
   }
 
   /// The fit to the keyframe, seeded with the frame-to-frame estimate (or the prediction).
@@ -202,19 +274,25 @@ struct OdometryPipeline::Impl {
     keyframe_registration.setInputTarget(flow_estimation.getKeyframeCloud());
     keyframe_registration.setInputFlow(keyframe_flow);
     selection.setPredictedMotion(rigidInverse(T_keyframe_guess));
-    if (selection.align(keyframe_registration)) {
-      result.T_world_curr =
-          T_world_keyframe *
-          keyframe_registration.getFinalTransformation().cast<double>();
+    const bool fitted = selection.align(keyframe_registration);
+    const Eigen::Matrix4d T_world_fit =
+        T_world_keyframe *
+        keyframe_registration.getFinalTransformation().cast<double>();
+    if (fitted && withinBound(rigidInverse(T_world_fit) * T_world_prev)) {
+      result.T_world_curr = T_world_fit;
       result.lost = false;
+      result.lost_reason = LostReason::none;
+      result.static_cells = keyframe_registration.getNumberOfInliers();
+      result.residual = keyframe_registration.getMeanSquaredResidual();
+      result.keyframe_index = static_cast<long>(keyframe_frame);
       // The first fit to a keyframe (the frame after it) is the reference of its overlap.
       const std::size_t inliers = keyframe_registration.getNumberOfInliers();
       if (keyframe_inliers == 0)
         keyframe_inliers = inliers;
       result.keyframe_overlap =
-          keyframe_inliers == 0 ? 0.0
-                                : static_cast<double>(inliers) /
-                                      static_cast<double>(keyframe_inliers);
+          keyframe_inliers == 0
+              ? 0.0
+              : static_cast<double>(inliers) / static_cast<double>(keyframe_inliers);
     }
     result.times.registration_ms += millisecondsSince(registration_start);
   }
@@ -246,7 +324,9 @@ struct OdometryPipeline::Impl {
   pcl::PointCloud<PointFlow>::Ptr keyframe_flow =
       pcl::make_shared<pcl::PointCloud<PointFlow>>();
   Eigen::Matrix4d T_world_keyframe = Eigen::Matrix4d::Identity();
-  std::size_t keyframe_inliers = 0; ///< inliers of the first fit to the keyframe (0: none yet)
+  std::size_t keyframe_inliers =
+      0; ///< inliers of the first fit to the keyframe (0: none yet)
+  std::size_t keyframe_frame = 0; ///< frame number of the keyframe
   StaticSetSelection<pcl::PointXYZRGB> selection;
   InlierNoiseTracker noise_tracker;
   StaticMaskRegistration<pcl::PointXYZRGB> backend;
@@ -256,7 +336,12 @@ struct OdometryPipeline::Impl {
   Eigen::Matrix4d T_world_prev =
       Eigen::Matrix4d::Identity();   ///< at the previous frame's depth instant
   double previous_depth_stamp = 0.0; ///< seconds
+  double previous_stamp = 0.0;       ///< the previous frame's colour stamp (s)
+  /// H_pred of this frame: the last step, scaled down to the motion bound over step_dt
   Eigen::Matrix4d T_curr_prev_predicted = Eigen::Matrix4d::Identity();
+  Eigen::Matrix4d last_step =
+      Eigen::Matrix4d::Identity(); ///< T_curr_prev of the last frame
+  double step_dt = 1.0 / 30.0;     ///< this frame's interval (s), the bound's duration
   std::size_t frames = 0;
   FrameResult result;
 };
@@ -288,13 +373,15 @@ OdometryPipeline::process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& clo
              "flagged lost: %s.\n",
              timestamp, result.error.c_str());
     result.lost = true;
-    result.T_curr_prev = p.T_curr_prev_predicted;
+    result.lost_reason = LostReason::bad_frame;
+    result.T_curr_prev = p.last_step;
     result.T_world_curr = p.T_world_prev * rigidInverse(result.T_curr_prev);
     result.labels.assign(static_cast<std::size_t>(result.width) * result.height,
                          LABEL_NONE);
     result.times.total_ms = millisecondsSince(start);
     return result;
   }
+  const double depth_stamp = std::isnan(depth_timestamp) ? timestamp : depth_timestamp;
   if (p.frames == 0) {
     p.flow_estimation.setInputCloud(cloud);
     // No motion to segment yet: under the start-up assumption (docs/algorithm.md §4, §6.1)
@@ -308,6 +395,14 @@ OdometryPipeline::process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& clo
     result.motions.assign(1, Eigen::Matrix4f::Identity());
   }
   else {
+    // Constant velocity, within the motion bound. The bound holds over the longer of the
+    // colour and depth intervals (TUM fr1 drops colour and depth frames at different
+    // instants); an interval that is not positive (stamps not increasing) counts as the last.
+    const double dt =
+        std::max(timestamp - p.previous_stamp, depth_stamp - p.previous_depth_stamp);
+    p.step_dt = std::isfinite(dt) && dt > 0.0 ? dt : p.step_dt;
+    const double share = shareWithinBound(p.last_step, p.step_dt, p.options);
+    p.T_curr_prev_predicted = share < 1.0 ? scaleStep(p.last_step, share) : p.last_step;
     p.track(cloud);
     result.T_world_curr = p.T_world_prev * rigidInverse(result.T_curr_prev);
     // The keyframe fit is the flow backend's; the other backends run frame to frame.
@@ -317,14 +412,13 @@ OdometryPipeline::process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& clo
     }
     if (p.frames % 100 == 0)
       orthonormalize(result.T_world_curr);
-    p.T_curr_prev_predicted = result.T_curr_prev;
+    p.last_step = result.T_curr_prev;
   }
   result.labels = paintLabelImage(result.segments, result.segment_labels, result.width,
                                   result.height)
                       .data;
   // The chain stays at the depth instants; the reported pose moves to the colour stamp.
   const Eigen::Matrix4d T_world_depth = result.T_world_curr;
-  const double depth_stamp = std::isnan(depth_timestamp) ? timestamp : depth_timestamp;
   if (p.frames > 0 && depth_stamp != timestamp &&
       depth_stamp > p.previous_depth_stamp) {
     // At most one step beyond the depth instant either way: an offset larger than a frame
@@ -338,6 +432,7 @@ OdometryPipeline::process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& clo
   }
   p.T_world_prev = T_world_depth;
   p.previous_depth_stamp = depth_stamp;
+  p.previous_stamp = timestamp;
   p.previous = cloud;
   ++p.frames;
   result.times.total_ms = millisecondsSince(start);

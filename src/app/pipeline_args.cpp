@@ -30,52 +30,23 @@ parameterFlags()
 {
   using S = PipelineStages;
   static const std::vector<ParameterFlag> flags{
-      {"threads",
-       "pipeline.threads",
-       "N",
-       "worker threads; results do not depend on it",
-       S::scene_flow},
-      {"cell_size",
-       "scene_flow.cell_size",
-       "PX",
-       "grid cell size",
-       S::scene_flow},
-      {"window_size",
-       "scene_flow.window_size",
-       "PX",
-       "LK window side",
-       S::scene_flow},
-      {"max_pyramid_level",
-       "scene_flow.max_pyramid_level",
-       "L",
-       "LK pyramid levels above the image",
-       S::scene_flow},
-      {"fb_check",
-       "scene_flow.forward_backward_check",
-       "",
-       "forward-backward scheme",
+      {"threads", "pipeline.threads", "N",
+       "worker threads; results do not depend on it", S::scene_flow},
+      {"cell_size", "scene_flow.cell_size", "PX", "grid cell size", S::scene_flow},
+      {"window_size", "scene_flow.window_size", "PX", "LK window side", S::scene_flow},
+      {"max_pyramid_level", "scene_flow.max_pyramid_level", "L",
+       "LK pyramid levels above the image", S::scene_flow},
+      {"fb_check", "scene_flow.forward_backward_check", "", "forward-backward scheme",
        S::scene_flow},
       {"seed", "segmentation.seed", "S", "hypothesis sampling seed", S::all},
-      {"no_tracking",
-       "segmentation.tracking",
-       "",
-       "two-frame segments (ids per frame) instead of tracked ids",
-       S::all},
-      {"no_segmentation",
-       "pipeline.use_segmentation",
-       "",
-       "ablation: every valid flow cell counts as static, no object labels",
-       S::all},
-      {"no_keyframes",
-       "pipeline.keyframes",
-       "",
-       "frame-to-frame registration only, no keyframe",
-       S::all},
-      {"backend",
-       "registration.backend",
-       "",
-       "ego-motion method on the static mask, from the flow estimate",
-       S::all},
+      {"no_tracking", "segmentation.tracking", "",
+       "two-frame segments (ids per frame) instead of tracked ids", S::all},
+      {"no_segmentation", "pipeline.use_segmentation", "",
+       "ablation: every valid flow cell counts as static, no object labels", S::all},
+      {"no_keyframes", "pipeline.keyframes", "",
+       "frame-to-frame registration only, no keyframe", S::all},
+      {"backend", "registration.backend", "",
+       "ego-motion method on the static mask, from the flow estimate", S::all},
   };
   return flags;
 }
@@ -176,6 +147,10 @@ appOptions(PipelineStages stages, std::vector<Option> own)
          "write <stamp>.pcd per frame: PointXYZRGBL, label as in the PNGs"});
     options.push_back(
         {"clouds_every", "N", "write the cloud of every N-th frame (default 1)"});
+    options.push_back(
+        {"frames_report", "FILE",
+         "write one TSV line per frame: stamp, lost and why, static cells, "
+         "residual, keyframe, moving share, ms per stage"});
   }
   options.push_back({"v", "", "verbose (PCL debug messages)"});
   options.push_back({"q", "", "quiet (errors only)"});
@@ -242,7 +217,8 @@ prepareRunOutputs(const Arguments& args,
   inputs.push_back(args.string("config"));
   outputs.insert(outputs.end(), {{"-objects", args.string("objects")},
                                  {"-objects_dir", args.string("objects_dir"), true},
-                                 {"-clouds_dir", args.string("clouds_dir"), true}});
+                                 {"-clouds_dir", args.string("clouds_dir"), true},
+                                 {"-frames_report", args.string("frames_report")}});
   prepareOutputs(outputs, inputs);
 }
 
@@ -261,6 +237,7 @@ runOutputPathsFromArguments(const Arguments& args,
   paths.clouds_every = static_cast<std::size_t>(
       args.integer("clouds_every", 1, 1, std::numeric_limits<long>::max()));
   paths.objects_dir = args.string("objects_dir");
+  paths.frames_report = args.string("frames_report");
   return paths;
 }
 
@@ -283,7 +260,8 @@ runPipeline(const PipelineOptions& options,
       {},
       RunReport(max_frames > 0 ? std::min(max_frames, source.size()) : source.size())};
   end.loop = processFrames(source, max_frames, [&](const Frame& frame) {
-    const auto& result = pipeline.process(frame.cloud, frame.timestamp, frame.depth_timestamp);
+    const auto& result =
+        pipeline.process(frame.cloud, frame.timestamp, frame.depth_timestamp);
     outputs.add(frame, result);
     if (on_result)
       on_result(frame, result);

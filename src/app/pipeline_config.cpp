@@ -72,6 +72,10 @@ PipelineOptions::table()
                 "new keyframe beyond this distance from it (m)"),
       makeField("keyframe_max_angle", &P::keyframe_max_angle, R::above(0),
                 "new keyframe beyond this rotation from it (rad)"),
+      makeField("max_speed", &P::max_speed, R::above(0),
+                "fits moving the camera faster are rejected (m/s)"),
+      makeField("max_rotation_rate", &P::max_rotation_rate, R::above(0),
+                "fits turning the camera faster are rejected (rad/s)"),
   });
   return table;
 }
@@ -96,10 +100,11 @@ pipelineConfigTable()
                  StaticSetSelectionParameters::table().fields()),
       nestFields("pipeline", &P::inlier_noise,
                  InlierNoiseTrackerParameters::table().fields()),
-      prefixFields("pipeline", {own.field("threads"), own.field("keyframes"),
-                                own.field("keyframe_min_overlap"),
-                                own.field("keyframe_max_distance"),
-                                own.field("keyframe_max_angle")})};
+      prefixFields("pipeline",
+                   {own.field("threads"), own.field("keyframes"),
+                    own.field("keyframe_min_overlap"),
+                    own.field("keyframe_max_distance"), own.field("keyframe_max_angle"),
+                    own.field("max_speed"), own.field("max_rotation_rate")})};
   return table;
 }
 

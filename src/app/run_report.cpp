@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <dynvo/app/run_report.h>
+#include <dynvo/common/conventions.h>
 #include <dynvo/common/timestamps.h>
 #include <dynvo/eval/trajectory_metrics.h>
 #include <dynvo/io/label_io.h>
@@ -48,13 +49,13 @@ RunOutputs::RunOutputs(const RunOutputPaths& paths,
     if (error || !fs::is_directory(folder))
       throw pcl::IOException(folder + ": cannot create the output folder");
   }
-  if (!paths_.objects.empty()) {
-    objects_file_ = std::make_unique<PartialFile>(paths_.objects);
-    objects_.open(objects_file_->partialPath(), std::ios::trunc);
-    if (!objects_)
-      throw pcl::IOException(paths_.objects + ": cannot write objects file");
-    objects_ << "# timestamp id n_pixels tx ty tz qx qy qz qw (T_curr_prev, metres)\n";
-  }
+  if (!paths_.objects.empty())
+    objects_ = std::make_unique<LineFile>(
+        paths_.objects,
+        "# timestamp id n_pixels tx ty tz qx qy qz qw (T_curr_prev, metres)");
+  if (!paths_.frames_report.empty())
+    frames_report_ =
+        std::make_unique<LineFile>(paths_.frames_report, frameReportHeader());
 }
 
 void
@@ -87,15 +88,13 @@ RunOutputs::add(const Frame& frame, const FrameResult& result)
     if (!paths_.objects_dir.empty())
       object_trajectories_.add(result, *frame.cloud, pose.T_world_camera);
   }
-  if (objects_.is_open()) {
+  if (objects_)
     for (std::size_t s = 1; s < result.segments.size(); ++s)
-      objects_ << formatObjectMotionLine(result.timestamp, result.segment_labels[s],
-                                         result.segments[s].indices.size(),
-                                         result.motions[s])
-               << '\n';
-    if (!objects_)
-      throw pcl::IOException(paths_.objects + ": write failed");
-  }
+      objects_->write(formatObjectMotionLine(result.timestamp, result.segment_labels[s],
+                                             result.segments[s].indices.size(),
+                                             result.motions[s]));
+  if (frames_report_)
+    frames_report_->write(formatFrameReportLine(result));
 }
 
 void
@@ -108,12 +107,64 @@ RunOutputs::finish()
     writeTrajectory(paths_.trajectory, trajectory_);
   if (!paths_.objects_dir.empty())
     writeObjectsFolder(paths_.objects_dir, object_trajectories_.tracks(), trajectory_);
-  if (objects_file_) {
-    objects_.close();
-    if (!objects_)
-      throw pcl::IOException(paths_.objects + ": write failed");
-    objects_file_->commit();
+  for (const auto& file : {objects_.get(), frames_report_.get()})
+    if (file)
+      file->commit();
+}
+
+std::string
+frameReportHeader()
+{
+  return "# stamp\tlost\treason\tstatic_cells\tresidual_m2\tkeyframe\tmoving_share\t"
+         "scene_flow_ms\tsegmentation_ms\tregistration_ms\ttotal_ms";
+}
+
+std::string
+formatFrameReportLine(const FrameResult& result)
+{
+  std::size_t labelled = 0;
+  std::size_t moving = 0;
+  for (const std::uint8_t label : result.labels) {
+    labelled += label != LABEL_NONE;
+    moving += label > LABEL_STATIC;
   }
+  const double share =
+      labelled > 0 ? static_cast<double>(moving) / static_cast<double>(labelled) : 0.0;
+  char line[256];
+  std::snprintf(line, sizeof(line),
+                "%s\t%d\t%s\t%zu\t%.3e\t%ld\t%.4f\t%.2f\t%.2f\t%.2f\t%.2f",
+                formatStamp(result.timestamp).c_str(), result.lost ? 1 : 0,
+                lostReasonName(result.lost_reason), result.static_cells,
+                result.residual, result.keyframe_index, share,
+                result.times.scene_flow_ms, result.times.segmentation_ms,
+                result.times.registration_ms, result.times.total_ms);
+  return line;
+}
+
+LineFile::LineFile(const std::string& path, const std::string& header)
+    : file_(path)
+{
+  out_.open(file_.partialPath(), std::ios::trunc);
+  if (!out_)
+    throw pcl::IOException(path + ": cannot write the file");
+  write(header);
+}
+
+void
+LineFile::write(const std::string& line)
+{
+  out_ << line << '\n';
+  if (!out_)
+    throw pcl::IOException(file_.path() + ": write failed");
+}
+
+void
+LineFile::commit()
+{
+  out_.close();
+  if (!out_)
+    throw pcl::IOException(file_.path() + ": write failed");
+  file_.commit();
 }
 
 RunReport::RunReport(std::size_t expected_frames)

@@ -63,6 +63,12 @@ struct DYNVO_EXPORTS PipelineOptions {
   double keyframe_max_distance =
       0.3;                          ///< ... or the camera moved farther from it (m) ...
   double keyframe_max_angle = 0.35; ///< ... or turned by more (rad, 20 deg)
+  /// Physical bound of the camera's motion (docs/algorithm.md §7.5): a fit that moves the
+  /// camera faster than max_speed (m/s) or turns it faster than max_rotation_rate (rad/s)
+  /// between the frames' depth instants, or is not finite, is rejected and the frame lost;
+  /// the constant-velocity prediction is scaled down to the same bound.
+  double max_speed = 3.0;
+  double max_rotation_rate = 4.0; ///< rad/s (229 deg/s)
 
   /// Names, units and ranges of the pipeline's own fields (use_segmentation, threads and
   /// the keyframe policy); the modules' fields, static_set's and inlier_noise's are in their
@@ -81,6 +87,19 @@ struct StageTimes {
   double total_ms = 0.0;        ///< the whole frame
 };
 
+/// Why a frame is lost (FrameResult::lost_reason).
+enum class LostReason {
+  none,                 ///< not lost
+  bad_frame,            ///< the frame broke the contract (FrameResult::error)
+  too_few_static_cells, ///< fewer usable static cells than the fit needs
+  degenerate,           ///< the static cells do not constrain a motion
+  beyond_bound ///< the fit was not finite or beyond PipelineOptions::max_speed or
+               ///< max_rotation_rate
+};
+
+/// "none", "bad_frame", "too_few_static_cells", "degenerate" or "beyond_bound".
+DYNVO_EXPORTS const char* lostReasonName(LostReason reason);
+
 /// Everything the pipeline knows about one frame.
 struct FrameResult {
   double timestamp = 0.0; ///< seconds (the colour image's stamp)
@@ -94,6 +113,14 @@ struct FrameResult {
   /// no ego-motion (too few static cells, or a bad frame: see error); T_curr_prev is then
   /// the constant-velocity prediction
   bool lost = false;
+  LostReason lost_reason = LostReason::none; ///< why lost (none when not)
+  /// static cells of the fit that gave the pose (its inliers; 0 when lost)
+  std::size_t static_cells = 0;
+  /// mean squared transfer error of those cells (m^2; 0 when lost)
+  double residual = 0.0;
+  /// frame number (from 0) of the keyframe the pose was measured against; -1 when the pose
+  /// is frame to frame or predicted
+  long keyframe_index = -1;
   /// this frame became the keyframe later frames are registered against
   bool keyframe = false;
   /// inliers of the fit to the keyframe over those of the first fit to it, on the frame

@@ -26,7 +26,7 @@ enum class PipelineStages {
  *
  * Both: -config, -write_config, -threads, -cell_size, -window_size, -max_pyramid_level,
  * -fb_check, -v, -q. PipelineStages::all adds -seed, -no_tracking, -no_segmentation,
- * -backend, -max_frames and the shared outputs -objects, -objects_dir, -clouds_dir and
+ * -backend, -max_frames and the shared outputs -objects, -objects_dir, -frames_report, -clouds_dir and
  * -clouds_every (runOutputPathsFromArguments()). Each parameter flag sets a key of
  * pipelineConfigTable() (its help names the key) and defaults to that key's value in
  * PipelineOptions(), so a flag means the same in every app and in a -config file.
@@ -65,7 +65,7 @@ DYNVO_EXPORTS bool writeConfigIfRequested(const Arguments& args,
 DYNVO_EXPORTS std::size_t maxFramesFromArguments(const Arguments& args);
 
 /** \brief prepareOutputs() for a run over a recording: the app's outputs plus the
- * shared -objects, -objects_dir and -clouds_dir; the inputs are the source's files and
+ * shared -objects, -objects_dir, -frames_report and -clouds_dir; the inputs are the source's files and
  * the -config file.
  * \throws UsageError naming the flag, the path and the problem
  */
@@ -74,7 +74,8 @@ DYNVO_EXPORTS void prepareRunOutputs(const Arguments& args,
                                      std::vector<OutputPath> outputs);
 
 /** \brief The outputs of a run: the app's trajectory and label folder ("" = none) plus
- * the shared -objects, -objects_dir, -clouds_dir and -clouds_every N (default 1).
+ * the shared -objects, -objects_dir, -frames_report, -clouds_dir and -clouds_every N
+ * (default 1).
  * \throws UsageError when -clouds_every is not a whole number >= 1 or is given without
  *         -clouds_dir
  */

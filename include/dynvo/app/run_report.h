@@ -24,7 +24,38 @@ struct RunOutputPaths {
   std::string objects;          ///< object-motion lines (formatObjectMotionLine())
   std::string clouds_dir;       ///< "<stamp>.pcd" labelled cloud (writeLabelledCloud())
   std::size_t clouds_every = 1; ///< clouds of frames 0, N, 2N, ... only (N >= 1)
-  std::string objects_dir; ///< object trajectories and summary (writeObjectsFolder())
+  std::string objects_dir;   ///< object trajectories and summary (writeObjectsFolder())
+  std::string frames_report; ///< one TSV line per frame (formatFrameReportLine())
+};
+
+/// The header line of a frames report (tab-separated column names after "# ").
+DYNVO_EXPORTS std::string frameReportHeader();
+
+/** \brief One frame of a frames report, tab-separated: stamp (s), lost (0/1), reason
+ * (lostReasonName()), static cells of the fit that gave the pose, its mean squared residual
+ * (m^2), keyframe (frame number of the keyframe the pose was measured against, -1 none),
+ * moving share (pixels labelled 2.. over pixels with a label), then the stage times and the
+ * total (ms).
+ */
+DYNVO_EXPORTS std::string formatFrameReportLine(const FrameResult& result);
+
+/** \brief A text file written line by line beside its destination ("<file>.partial") and
+ * moved into place by commit(); destroyed uncommitted, it leaves the destination as it was.
+ */
+class DYNVO_EXPORTS LineFile {
+public:
+  /// \throws pcl::IOException naming path when the partial file cannot be created
+  LineFile(const std::string& path, const std::string& header);
+
+  /// Appends line and a newline. \throws pcl::IOException naming the file on failure
+  void write(const std::string& line);
+
+  /// Moves the file into place. \throws pcl::IOException naming the file on failure
+  void commit();
+
+private:
+  PartialFile file_;
+  std::ofstream out_;
 };
 
 /** \brief The files of a run. Label images and clouds are written as frames arrive
@@ -60,8 +91,8 @@ private:
   RunOutputPaths paths_;
   const Trajectory* initial_groundtruth_;
   Eigen::Isometry3d T_world_start_ = Eigen::Isometry3d::Identity();
-  std::unique_ptr<PartialFile> objects_file_; ///< removes the partial file unless moved
-  std::ofstream objects_;
+  std::unique_ptr<LineFile> objects_;       ///< paths_.objects, or none
+  std::unique_ptr<LineFile> frames_report_; ///< paths_.frames_report, or none
   Trajectory trajectory_;
   ObjectTrajectories object_trajectories_;
 };

@@ -204,10 +204,11 @@ void
 GridFlowEngine::compute(const GridSceneFlowParameters& params,
                         const CameraIntrinsics& intrinsics,
                         unsigned threads,
+                        const Eigen::Matrix4f& T_previous_current,
                         pcl::PointCloud<PointFlow>& flow) const
 {
-  track(*previous_, params, intrinsics, threads, nullptr, {}, params.max_pyramid_level,
-        flow);
+  track(*previous_, params, intrinsics, threads, T_previous_current, {},
+        params.max_pyramid_level, flow);
 }
 
 void
@@ -222,7 +223,7 @@ GridFlowEngine::computeToKeyframe(const GridSceneFlowParameters& params,
   if (!keyframe_)
     throw std::logic_error(
         "[dynvo::detail::GridFlowEngine::computeToKeyframe] no keyframe kept");
-  track(*keyframe_, params, intrinsics, threads, &T_keyframe_current, selected,
+  track(*keyframe_, params, intrinsics, threads, T_keyframe_current, selected,
         std::clamp(max_level, 0, params.max_pyramid_level), flow);
 }
 
@@ -231,7 +232,7 @@ GridFlowEngine::track(const Frame& reference,
                       const GridSceneFlowParameters& params,
                       const CameraIntrinsics& intrinsics,
                       unsigned threads,
-                      const Eigen::Matrix4f* T_reference_current,
+                      const Eigen::Matrix4f& T_reference_current,
                       const std::vector<std::uint8_t>& selected,
                       int max_level,
                       pcl::PointCloud<PointFlow>& flow) const
@@ -262,24 +263,23 @@ GridFlowEngine::track(const Frame& reference,
       centre_depth[i] = z_b;
     }
 
-  // Cells to track, and where each starts in the reference frame when seeded: the
-  // projection of T_reference_current * b_i (unselected cells and those without depth or
-  // seed are left out).
+  // Cells to track, and where each starts in the reference frame: the projection of
+  // T_reference_current * b_i, or of the cell's ray rotated alone (a point at infinity) when
+  // it has no depth. Unselected cells and those whose start leaves the image are left out.
   std::vector<std::size_t> tracked_cells;
   std::vector<cv::Point2f> seeds;
   tracked_cells.reserve(n);
+  seeds.reserve(n);
+  const Eigen::Matrix3f R = T_reference_current.topLeftCorner<3, 3>();
+  const Eigen::Vector3f t = T_reference_current.topRightCorner<3, 1>();
   for (std::size_t i = 0; i < n; ++i) {
-    if (!T_reference_current) {
-      tracked_cells.push_back(i);
+    if (!selected.empty() && !selected[i])
       continue;
-    }
-    if (std::isnan(centre_depth[i]) || (!selected.empty() && !selected[i]))
-      continue;
+    const bool at_infinity = std::isnan(centre_depth[i]);
+    const Eigen::Vector3f b = intrinsics.backproject(
+        centres[i].x, centres[i].y, at_infinity ? 1.0f : centre_depth[i]);
     const Eigen::Vector3f q =
-        (*T_reference_current *
-         intrinsics.backproject(centres[i].x, centres[i].y, centre_depth[i])
-             .homogeneous())
-            .head<3>();
+        at_infinity ? Eigen::Vector3f(R * b) : Eigen::Vector3f(R * b + t);
     if (!(q.z() > 0.0f))
       continue;
     const Eigen::Vector2f seed = intrinsics.project(q);
@@ -306,14 +306,11 @@ GridFlowEngine::track(const Frame& reference,
     std::vector<cv::Point2f> from;
     for (std::size_t k = begin; k < end; ++k)
       from.push_back(centres[tracked_cells[k]]);
-    std::vector<cv::Point2f> to;
-    if (T_reference_current)
-      to.assign(seeds.begin() + begin, seeds.begin() + end);
+    std::vector<cv::Point2f> to(seeds.begin() + begin, seeds.begin() + end);
     std::vector<std::uint8_t> status;
     cv::calcOpticalFlowPyrLK(curr.pyramid, prev.pyramid, from, to, status,
                              cv::noArray(), window, max_level, criteria,
-                             T_reference_current ? cv::OPTFLOW_USE_INITIAL_FLOW : 0,
-                             params.min_eigen_threshold);
+                             cv::OPTFLOW_USE_INITIAL_FLOW, params.min_eigen_threshold);
     std::vector<cv::Point2f> forward;
     std::vector<std::size_t> index;
     for (std::size_t k = 0; k < from.size(); ++k) {

@@ -62,12 +62,16 @@ public:
   bool hasKeyframe() const { return keyframe_ != nullptr; }
 
   /** \brief Grid scene flow from the previous to the current slot (docs/algorithm.md §1.2).
-   * Both slots must have been prepared with the same size and params.
+   * Both slots must have been prepared with the same size and params. Every cell starts at
+   * its predicted position in the previous frame, the projection of T_previous_current * b_i
+   * (a cell without depth: of its ray, as a point at infinity), and is tracked over the
+   * whole pyramid; identity starts every cell where it is.
    * \param[out] flow organized (width / cell_size) x (height / cell_size) cloud
    */
   void compute(const GridSceneFlowParameters& params,
                const CameraIntrinsics& intrinsics,
                unsigned threads,
+               const Eigen::Matrix4f& T_previous_current,
                pcl::PointCloud<PointFlow>& flow) const;
 
   /** \brief Grid scene flow from the keyframe to the current slot, seeded (docs/algorithm.md
@@ -92,14 +96,14 @@ public:
 private:
   struct Frame;
 
-  /// Tracks the cells of the current slot into reference (seeded when T_reference_current
-  /// is given, then only the selected ones) and back-projects both ends: compute() and
-  /// computeToKeyframe().
+  /// Tracks the selected cells of the current slot into reference, each from its
+  /// predicted position under T_reference_current, and back-projects both ends: compute()
+  /// and computeToKeyframe().
   void track(const Frame& reference,
              const GridSceneFlowParameters& params,
              const CameraIntrinsics& intrinsics,
              unsigned threads,
-             const Eigen::Matrix4f* T_reference_current,
+             const Eigen::Matrix4f& T_reference_current,
              const std::vector<std::uint8_t>& selected,
              int max_level,
              pcl::PointCloud<PointFlow>& flow) const;

@@ -91,6 +91,19 @@ public:
    */
   void compute(FlowCloud& flow);
 
+  /** \brief Predicted camera motion H_pred = T_curr_prev of the next compute() (metres;
+   * default identity): each cell starts its search at its predicted position in the previous
+   * frame (a cell without depth as a point at infinity) and the whole pyramid is searched
+   * around it, so a fast but steady motion stays within the pyramid's reach
+   * (docs/algorithm.md §1.2).
+   */
+  void setPredictedMotion(const Eigen::Matrix4f& T_curr_prev)
+  {
+    predicted_motion_ = T_curr_prev;
+  }
+
+  const Eigen::Matrix4f& getPredictedMotion() const { return predicted_motion_; }
+
   /** \brief Keeps the current frame of the last compute() as the keyframe (its pyramid and
    * depth map are shared, not copied), replacing the previous keyframe.
    * \return false (logged with PCL_ERROR) when compute() has not prepared the input cloud
@@ -181,6 +194,7 @@ private:
   std::vector<std::uint8_t> grey_;     ///< conversion buffer (grey levels)
   std::vector<float> depth_;           ///< conversion buffer (metres)
   std::vector<std::uint8_t> selected_; ///< cells computeToKeyframe() tracks
+  Eigen::Matrix4f predicted_motion_ = Eigen::Matrix4f::Identity(); ///< H_pred
 };
 
 } // namespace dynvo

@@ -4,6 +4,7 @@
 
 #include <dynvo/common/image.h>
 #include <dynvo/common/flow_grid.h>
+#include <dynvo/common/rigid_fit.h>
 #include <dynvo/scene_flow/grid_scene_flow_estimation.h>
 
 #include <pcl/console/print.h>
@@ -162,7 +163,8 @@ GridSceneFlowEstimation<PointT>::compute(FlowCloud& flow)
   if (!previous_ready_)
     prepareFrame(*previous_, detail::GridFlowEngine::Slot::previous);
   previous_ready_ = true;
-  engine_.compute(params_, intrinsics_, threads_, flow);
+  engine_.compute(params_, intrinsics_, threads_,
+                  rigidInverse(predicted_motion_.cast<double>()).cast<float>(), flow);
   flow.header = input_->header;
 }
 
