@@ -59,8 +59,9 @@ composite(const dynvo::app::Arguments& args)
   dynvo::app::prepareOutputs({{"-out", out, true}}, {composite.recording});
   pcl::console::TicToc timer;
   timer.tic();
+  std::size_t skipped = 0;
   try {
-    dynvo::app::writeCompositeSequence(options, composite, out);
+    skipped = dynvo::app::writeCompositeSequence(options, composite, out);
   }
   catch (const std::invalid_argument& e) { // a scenario without objects
     throw dynvo::app::UsageError(e.what());
@@ -70,6 +71,9 @@ composite(const dynvo::app::Arguments& args)
                                 composite.recording.c_str(), out.c_str());
   pcl::console::print_value("%.2f", timer.toc() / 1000.0);
   pcl::console::print_info(" s\n");
+  if (skipped > 0)
+    std::printf("skipped %zu frames of %s without ground truth\n", skipped,
+                composite.recording.c_str());
   return 0;
 }
 

@@ -885,6 +885,60 @@ TEST(SceneSynthesizer, CompositeRefusesBadRecordingsAndObjectlessScenarios)
   EXPECT_FALSE(fs::exists(dir.path() / "b")); // inputs are checked before any output
 }
 
+TEST(SceneSynthesizer, CompositeSkipsFramesWithoutGroundTruth)
+{
+  // Motion capture that starts after the recording (TUM fr3/teddy's first stamps have
+  // none): frames 0-6 (100.000-100.200 s) have no pose within the 100 Hz ground truth that
+  // starts at 100.21 s, frames 7-11 have one.
+  const dynvo::test::TempDir dir;
+  writeRecording(dir.path() / "real", 12, 32, 24);
+  {
+    std::ofstream gt(dir.path() / "real/groundtruth.txt");
+    for (int j = 0; j < 30; ++j)
+      gt << std::fixed << std::setprecision(4) << 100.21 + 0.01 * j << ' ' << 0.002 * j
+         << " 0 0 0 0 0 1\n";
+  }
+  dynvo::SynthOptions options;
+  options.scenario = "moving_crossing";
+  dynvo::app::CompositeOptions composite;
+  composite.recording = (dir.path() / "real").string();
+  EXPECT_EQ(dynvo::app::writeCompositeSequence(options, composite, dir.file("all")),
+            7u);
+  const auto stamps = [&](const std::string& folder) {
+    std::vector<double> result;
+    std::ifstream list(dir.path() / folder / "rgb.txt");
+    for (std::string line; std::getline(list, line);)
+      if (!line.empty() && line[0] != '#')
+        result.push_back(std::stod(line));
+    return result;
+  };
+  const std::vector<double> all = stamps("all");
+  ASSERT_EQ(all.size(), 5u);
+  EXPECT_NEAR(all.front(), 100.0 + 7 / 30.0, 1e-6);
+  // -frames N counts the frames written: the first N that have ground truth.
+  composite.frames = 3;
+  EXPECT_EQ(dynvo::app::writeCompositeSequence(options, composite, dir.file("three")),
+            7u);
+  const std::vector<double> three = stamps("three");
+  ASSERT_EQ(three.size(), 3u);
+  EXPECT_NEAR(three.front(), all.front(), 1e-6);
+  // No frame with ground truth: refused, naming the recording, before any output.
+  {
+    std::ofstream gt(dir.path() / "real/groundtruth.txt");
+    gt << "200.0 0 0 0 0 0 0 1\n200.01 0 0 0 0 0 0 1\n";
+  }
+  composite.frames = 0;
+  try {
+    dynvo::app::writeCompositeSequence(options, composite, dir.file("none"));
+    ADD_FAILURE() << "a recording without any ground truth at its frames was accepted";
+  }
+  catch (const pcl::IOException& e) {
+    EXPECT_NE(std::string(e.what()).find("ground truth"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_FALSE(fs::exists(dir.path() / "none"));
+}
+
 TEST(SceneCompositor, ContractOnPlainInputs)
 {
   dynvo::SynthOptions options;

@@ -71,6 +71,24 @@ scaleStep(const Eigen::Matrix4d& T_curr_prev, double x)
       .matrix();
 }
 
+/// RMS distance (metres) by which the step T_curr_prev moves the previous-frame points a_i
+/// of the valid flow cells; 0 without any.
+double
+predictedDisplacement(const pcl::PointCloud<PointFlow>& flow,
+                      const Eigen::Matrix4d& T_curr_prev)
+{
+  double sum = 0.0;
+  std::size_t count = 0;
+  for (const PointFlow& cell : flow) {
+    if (!cell.valid_3d)
+      continue;
+    const Eigen::Vector3d a(cell.prev_x, cell.prev_y, cell.prev_z);
+    sum += ((T_curr_prev * a.homogeneous()).head<3>() - a).squaredNorm();
+    ++count;
+  }
+  return count > 0 ? std::sqrt(sum / static_cast<double>(count)) : 0.0;
+}
+
 LostReason
 lostReasonOf(StaticRegistrationStatus status)
 {
@@ -142,7 +160,6 @@ struct OdometryPipeline::Impl {
     registration.setParameters(options.registration);
     keyframe_registration.setParameters(options.registration);
     selection.setParameters(options.static_set);
-    selection.setMotionGuardTolerance(options.segmentation.static_guard_tolerance);
     noise_tracker.setParameters(options.inlier_noise);
     noise_tracker.setUpperBound(options.segmentation.inlier_threshold);
     backend.setParameters(options.backend);
@@ -173,6 +190,12 @@ struct OdometryPipeline::Impl {
     result.times.scene_flow_ms = millisecondsSince(flow_start);
 
     const auto segmentation_start = Clock::now();
+    // The ego-motion guard's tolerance grows with the predicted motion (docs/algorithm.md
+    // §7); the segmentation's background guard keeps tau_cv.
+    selection.setMotionGuardTolerance(
+        options.segmentation.static_guard_tolerance +
+        options.guard_motion_factor *
+            predictedDisplacement(*flow, T_curr_prev_predicted));
     if (options.use_segmentation) {
       result.inlier_threshold = noise_tracker.getInlierThreshold();
       segmentation.setInlierThreshold(static_cast<float>(result.inlier_threshold));

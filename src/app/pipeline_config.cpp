@@ -76,6 +76,8 @@ PipelineOptions::table()
                 "fits moving the camera faster are rejected (m/s)"),
       makeField("max_rotation_rate", &P::max_rotation_rate, R::above(0),
                 "fits turning the camera faster are rejected (rad/s)"),
+      makeField("guard_motion_factor", &P::guard_motion_factor, R::atLeast(0),
+                "motion guard tolerance grows by this share of the predicted motion"),
   });
   return table;
 }
@@ -104,7 +106,8 @@ pipelineConfigTable()
                    {own.field("threads"), own.field("keyframes"),
                     own.field("keyframe_min_overlap"),
                     own.field("keyframe_max_distance"), own.field("keyframe_max_angle"),
-                    own.field("max_speed"), own.field("max_rotation_rate")})};
+                    own.field("max_speed"), own.field("max_rotation_rate"),
+                    own.field("guard_motion_factor")})};
   return table;
 }
 

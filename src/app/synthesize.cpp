@@ -40,16 +40,6 @@ objectPoses(const std::vector<ObjectState>& objects)
   return poses;
 }
 
-/// The recording's camera at a colour stamp. \throws pcl::IOException naming `file`
-Eigen::Isometry3d
-cameraAt(const Trajectory& groundtruth, double stamp, const fs::path& file)
-{
-  if (const auto pose = interpolatePose(groundtruth, stamp, MAX_GROUNDTRUTH_GAP))
-    return *pose;
-  throw pcl::IOException(file.string() + ": no ground truth around stamp " +
-                         formatStamp(stamp));
-}
-
 /// \throws pcl::IOException naming `file` when the images' sizes differ from w x h
 void
 checkSize(const ColorImage& color,
@@ -116,7 +106,7 @@ writeSyntheticSequence(const SynthOptions& options,
                     entries, groundtruth);
 }
 
-void
+std::size_t
 writeCompositeSequence(const SynthOptions& options,
                        const CompositeOptions& composite,
                        const std::string& folder)
@@ -133,22 +123,36 @@ writeCompositeSequence(const SynthOptions& options,
   const TumFolderSource source(composite.recording, source_options);
   const fs::path groundtruth_path = recording / "groundtruth.txt";
   const Trajectory groundtruth = readTrajectory(groundtruth_path.string());
-  const std::size_t frames =
-      composite.frames > 0
-          ? std::min<std::size_t>(source.size(),
-                                  static_cast<std::size_t>(composite.frames))
-          : source.size();
-  if (frames == 0)
-    throw pcl::IOException(recording.string() + ": no associated colour/depth pairs");
-  const auto& entries = source.entries();
+  // The associated pairs with a camera: the recording's ground truth interpolated at the
+  // colour stamp. Pairs without one (TUM fr3 starts before its motion capture) are skipped.
+  const std::size_t wanted =
+      composite.frames > 0 ? static_cast<std::size_t>(composite.frames) : source.size();
+  std::vector<TumFolderSource::Entry> entries;
+  std::vector<double> rgb_stamps;
+  std::vector<Eigen::Isometry3d> T_world_camera;
+  std::size_t skipped = 0;
+  for (const TumFolderSource::Entry& entry : source.entries()) {
+    if (entries.size() == wanted)
+      break;
+    const auto pose =
+        interpolatePose(groundtruth, entry.rgb_stamp, MAX_GROUNDTRUTH_GAP);
+    if (!pose) {
+      ++skipped;
+      continue;
+    }
+    entries.push_back(entry);
+    rgb_stamps.push_back(entry.rgb_stamp);
+    T_world_camera.push_back(*pose);
+  }
+  if (entries.empty())
+    throw pcl::IOException(
+        recording.string() +
+        (source.size() == 0 ? ": no associated colour/depth pairs"
+                            : ": no associated colour/depth pair has ground truth in " +
+                                  groundtruth_path.string()));
+  const std::size_t frames = entries.size();
 
   // Everything that can fail on the inputs is checked before the folder is made.
-  std::vector<double> rgb_stamps(frames);
-  std::vector<Eigen::Isometry3d> T_world_camera(frames);
-  for (std::size_t k = 0; k < frames; ++k) {
-    rgb_stamps[k] = entries[k].rgb_stamp;
-    T_world_camera[k] = cameraAt(groundtruth, entries[k].rgb_stamp, groundtruth_path);
-  }
   const ColorImage first_color =
       readColorImage((recording / entries[0].rgb_file).string());
   const RawDepthImage first_depth =
@@ -185,6 +189,7 @@ writeCompositeSequence(const SynthOptions& options,
                         std::to_string(compositor.objectScale()) + ") into " +
                         recording.string() + "\n",
                     index, groundtruth);
+  return skipped;
 }
 
 } // namespace dynvo::app

@@ -69,6 +69,11 @@ struct DYNVO_EXPORTS PipelineOptions {
   /// the constant-velocity prediction is scaled down to the same bound.
   double max_speed = 3.0;
   double max_rotation_rate = 4.0; ///< rad/s (229 deg/s)
+  /// The motion guard's tolerance (segmentation.static_guard_tolerance, tau_cv) grows by
+  /// this share of the RMS distance the predicted motion moves the flow's points: a
+  /// constant-velocity prediction is off by more when the camera moves fast
+  /// (docs/algorithm.md §7; 0 = the fixed tau_cv).
+  double guard_motion_factor = 0.5;
 
   /// Names, units and ranges of the pipeline's own fields (use_segmentation, threads and
   /// the keyframe policy); the modules' fields, static_set's and inlier_noise's are in their

@@ -32,24 +32,26 @@ struct CompositeOptions {
   std::string recording;       ///< TUM folder: rgb.txt, depth.txt, groundtruth.txt
   CameraIntrinsics intrinsics; ///< the recording's camera
   double depth_scale = 0.0;    ///< raw depth units per metre; 0 = the folder's default
-  int frames = 0;              ///< the first N associated frames; 0 = all
+  int frames = 0; ///< the first N associated frames with ground truth; 0 = all
 };
 
 /** \brief Composites the scenario's rigid objects into a real TUM recording
  * (dynvo::SceneCompositor) and writes the result like writeSyntheticSequence().
  *
- * Frame k of the output is associated pair k of the recording, at its stamps; the
- * camera pose is the recording's ground truth interpolated at the colour stamp (linear
- * translation, slerp rotation, across gaps of at most 0.25 s). objects.txt holds the
+ * Frame k of the output is the k-th associated pair of the recording that has ground
+ * truth, at its stamps; the camera pose is the recording's ground truth interpolated at the
+ * colour stamp (linear translation, slerp rotation, across gaps of at most 0.25 s). Pairs
+ * without ground truth around their colour stamp are skipped. objects.txt holds the
  * objects in the recording's world; groundtruth.txt is the recording's. Every input is
  * read and checked before the output folder is made.
  * \param[in] folder must not exist or be empty; nothing existing is overwritten
+ * \return the associated pairs skipped for want of ground truth
  * \throws std::invalid_argument when the scenario has no objects or frames < 0
  * \throws pcl::IOException when the recording cannot be read (missing or wrong-type
- *         image, no ground truth at a stamp) or the folder cannot be written
+ *         image, no pair with ground truth) or the folder cannot be written
  */
-DYNVO_EXPORTS void writeCompositeSequence(const SynthOptions& options,
-                                          const CompositeOptions& composite,
-                                          const std::string& folder);
+DYNVO_EXPORTS std::size_t writeCompositeSequence(const SynthOptions& options,
+                                                 const CompositeOptions& composite,
+                                                 const std::string& folder);
 
 } // namespace dynvo::app

@@ -208,7 +208,7 @@ GridFlowEngine::compute(const GridSceneFlowParameters& params,
                         pcl::PointCloud<PointFlow>& flow) const
 {
   track(*previous_, params, intrinsics, threads, T_previous_current, {},
-        params.max_pyramid_level, flow);
+        params.max_pyramid_level, true, flow);
 }
 
 void
@@ -224,7 +224,7 @@ GridFlowEngine::computeToKeyframe(const GridSceneFlowParameters& params,
     throw std::logic_error(
         "[dynvo::detail::GridFlowEngine::computeToKeyframe] no keyframe kept");
   track(*keyframe_, params, intrinsics, threads, T_keyframe_current, selected,
-        std::clamp(max_level, 0, params.max_pyramid_level), flow);
+        std::clamp(max_level, 0, params.max_pyramid_level), false, flow);
 }
 
 void
@@ -235,6 +235,7 @@ GridFlowEngine::track(const Frame& reference,
                       const Eigen::Matrix4f& T_reference_current,
                       const std::vector<std::uint8_t>& selected,
                       int max_level,
+                      bool identity_within_reach,
                       pcl::PointCloud<PointFlow>& flow) const
 {
   const Frame& curr = *current_;
@@ -288,6 +289,26 @@ GridFlowEngine::track(const Frame& reference,
       continue;
     tracked_cells.push_back(i);
     seeds.emplace_back(seed.x(), seed.y());
+  }
+  // Frame to frame, a prediction within the pyramid's reach of the cells (half a window on
+  // the top level: (window / 2) * 2^max_level px, median over the cells) is not needed, and
+  // the search starts at every cell itself.
+  if (identity_within_reach && !seeds.empty()) {
+    std::vector<float> shift(seeds.size());
+    for (std::size_t k = 0; k < seeds.size(); ++k)
+      shift[k] = static_cast<float>(cv::norm(seeds[k] - centres[tracked_cells[k]]));
+    std::nth_element(shift.begin(), shift.begin() + shift.size() / 2, shift.end());
+    const float reach = 0.5f * static_cast<float>(params.window_size) *
+                        static_cast<float>(1 << max_level);
+    if (shift[shift.size() / 2] <= reach) {
+      tracked_cells.clear();
+      seeds.clear();
+      for (std::size_t i = 0; i < n; ++i)
+        if (selected.empty() || selected[i]) {
+          tracked_cells.push_back(i);
+          seeds.push_back(centres[i]);
+        }
+    }
   }
 
   // Track every selected centre c_i from I^k into the reference (p_i), then p_i back

@@ -62,10 +62,12 @@ public:
   bool hasKeyframe() const { return keyframe_ != nullptr; }
 
   /** \brief Grid scene flow from the previous to the current slot (docs/algorithm.md §1.2).
-   * Both slots must have been prepared with the same size and params. Every cell starts at
-   * its predicted position in the previous frame, the projection of T_previous_current * b_i
-   * (a cell without depth: of its ray, as a point at infinity), and is tracked over the
-   * whole pyramid; identity starts every cell where it is.
+   * Both slots must have been prepared with the same size and params. When the prediction
+   * moves the cells farther than the pyramid reaches ((window_size / 2) * 2^max_pyramid_level
+   * px, median over the cells), every cell starts at its predicted position in the previous
+   * frame, the projection of T_previous_current * b_i (a cell without depth: of its ray, as a
+   * point at infinity); otherwise every cell starts where it is. The whole pyramid is
+   * searched.
    * \param[out] flow organized (width / cell_size) x (height / cell_size) cloud
    */
   void compute(const GridSceneFlowParameters& params,
@@ -97,8 +99,10 @@ private:
   struct Frame;
 
   /// Tracks the selected cells of the current slot into reference, each from its
-  /// predicted position under T_reference_current, and back-projects both ends: compute()
-  /// and computeToKeyframe().
+  /// predicted position under T_reference_current (from the cell itself instead when
+  /// identity_within_reach and the prediction moves the cells by no more than the pyramid
+  /// reaches, median over the cells), and back-projects both ends: compute() and
+  /// computeToKeyframe().
   void track(const Frame& reference,
              const GridSceneFlowParameters& params,
              const CameraIntrinsics& intrinsics,
@@ -106,6 +110,7 @@ private:
              const Eigen::Matrix4f& T_reference_current,
              const std::vector<std::uint8_t>& selected,
              int max_level,
+             bool identity_within_reach,
              pcl::PointCloud<PointFlow>& flow) const;
 
   std::shared_ptr<Frame> current_;
