@@ -159,6 +159,10 @@ struct OdometryPipeline::Impl {
     segmentation.setNumberOfThreads(options.threads);
     registration.setParameters(options.registration);
     keyframe_registration.setParameters(options.registration);
+    const auto focal =
+        static_cast<float>(0.5 * (options.intrinsics.fx + options.intrinsics.fy));
+    registration.setSensorNoise(options.segmentation.noise, focal);
+    keyframe_registration.setSensorNoise(options.segmentation.noise, focal);
     selection.setParameters(options.static_set);
     noise_tracker.setParameters(options.inlier_noise);
     noise_tracker.setUpperBound(options.segmentation.inlier_threshold);

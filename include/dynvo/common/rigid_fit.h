@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <vector>
 
 namespace dynvo {
 
@@ -75,6 +76,37 @@ private:
   Eigen::Matrix3d cross_sum_ =
       Eigen::Matrix3d::Zero(); ///< sum w_i (q_i - q0)(s_i - s0)^T
 };
+
+/// One pair of an information-weighted fit: R source + t should equal target, with the
+/// error's information matrix (m^-2, symmetric positive semi-definite) and a weight >= 0.
+struct InformationPair {
+  Eigen::Vector3d source;      ///< s_i (metres, source frame)
+  Eigen::Vector3d target;      ///< q_i (metres, target frame)
+  Eigen::Matrix3d information; ///< W_i, e.g. SensorNoiseModel::transferInformation()
+  double weight = 1.0;         ///< w_i >= 0
+};
+
+/** \brief Gauss-Newton refinement of a rigid fit under anisotropic noise
+ * (docs/algorithm.md §7.2).
+ *
+ * Minimises sum_i w_i rho(d_i) with the Mahalanobis distance
+ * d_i^2 = r_i^T W_i r_i, r_i = R s_i + t - q_i, and Huber's rho with threshold huber (sigma):
+ * pairs with d_i > huber count with weight huber / d_i (iteratively reweighted). Each step
+ * solves the 6x6 normal equations for a left increment exp(xi) T, xi = (t, omega); it starts
+ * from T_target_source (a RigidFitAccumulator fit). Structured-light depth is 1.6-6x noisier
+ * along the ray than across it over 0.6-4.5 m (Kinect v1) and its noise grows with z^2, so
+ * this fit trusts each pair's lateral (tracked) component and the near points more, where
+ * the metric fit lets the far points' depth noise dominate.
+ * \param[in] pairs at least 3 pairs with a positive weight
+ * \param[in] iterations Gauss-Newton steps (>= 0; 0 leaves T_target_source unchanged)
+ * \param[in] huber threshold of the robust loss (sigma, > 0)
+ * \param[in,out] T_target_source start and result; written only when the result is ok
+ * \return ok, too_few_points, or degenerate when the normal equations are singular
+ */
+DYNVO_EXPORTS RigidFitStatus refineRigidFit(const std::vector<InformationPair>& pairs,
+                                            int iterations,
+                                            double huber,
+                                            Eigen::Matrix4d& T_target_source);
 
 /** \brief Squared transfer error E_i = || R s + t - q ||^2 (m^2) of one pair under
  * T_target_source (the paper's eq. 1, docs/algorithm.md §2).

@@ -6,6 +6,7 @@
 #include <dynvo/common/export.h>
 #include <dynvo/common/flow_grid.h>
 #include <dynvo/common/point_types.h>
+#include <dynvo/common/sensor_noise_model.h>
 #include <dynvo/registration/lazy_kd_tree.h>
 #include <dynvo/registration/static_scene_registration_parameters.h>
 
@@ -177,6 +178,19 @@ public:
   DYNVO_PARAMETER_ACCESSORS(TrimFactor, trim_factor)
   DYNVO_PARAMETER_ACCESSORS(TrimRounds, trim_rounds)
   DYNVO_PARAMETER_ACCESSORS(MinCorrespondences, min_correspondences)
+  DYNVO_PARAMETER_ACCESSORS(InformationIterations, information_iterations)
+  DYNVO_PARAMETER_ACCESSORS(HuberThreshold, huber_threshold)
+
+  /** \brief The depth camera's noise for the information-weighted fit (docs/algorithm.md
+   * §7.2): each kept cell's transfer error is weighed by
+   * noise.transferInformation(a_i, b_i, focal, axial_gain, lateral_gain).
+   * Defaults: SensorNoiseModel(), focal 525 px (Kinect v1), gains 1.
+   * \throws std::invalid_argument when noise.validate() fails or a number is not > 0
+   */
+  void setSensorNoise(const SensorNoiseModel& noise,
+                      float focal,
+                      float axial_gain = 1.0f,
+                      float lateral_gain = 1.0f);
 
 protected:
   using Base::converged_;
@@ -218,6 +232,9 @@ private:
   void resetResults(const Matrix4& guess);
 
   Parameters params_;                    ///< validated knobs
+  SensorNoiseModel noise_;               ///< setSensorNoise()
+  float focal_ = 525.0f;                 ///< focal length of the noise model (px)
+  std::array<float, 2> noise_gains_{1.0f, 1.0f}; ///< {axial, lateral} gains
   FlowCloudConstPtr flow_;               ///< grid scene flow k-1 -> k
   Status status_ = Status::not_computed; ///< outcome of the last align()
   double mean_squared_residual_ =

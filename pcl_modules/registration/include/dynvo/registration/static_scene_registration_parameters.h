@@ -11,7 +11,9 @@ namespace dynvo {
  *
  * The flow estimate follows docs/algorithm.md §7: a weighted least-squares fit on the
  * static cells,
- * then trim_rounds rounds that keep the cells with E_i <= trim_factor * th_inlier and refit.
+ * then trim_rounds rounds that keep the cells with E_i <= trim_factor * th_inlier and refit,
+ * then information_iterations Gauss-Newton steps that weigh each kept cell by the inverse
+ * covariance of its transfer error under the sensor noise model (§7.2; 0 = the paper's fit).
  * Other methods on the static mask are StaticMaskRegistration's.
  */
 struct DYNVO_EXPORTS StaticSceneRegistrationParameters {
@@ -22,6 +24,10 @@ struct DYNVO_EXPORTS StaticSceneRegistrationParameters {
       2; ///< trim rounds (>= 0): trim-and-refit rounds after the first fit
   int min_correspondences =
       6; ///< (>= 3): fewer usable static cells is "too few"; a trim round leaving fewer keeps the previous fit
+  int information_iterations =
+      4; ///< (>= 0): Gauss-Newton steps of the information-weighted fit, 0 = off (paper)
+  float huber_threshold =
+      3.0f; ///< (sigma, > 0): Mahalanobis distance above which a cell's weight falls as 1/d
 
   /// Names, units and ranges of the fields above, in file order (ParameterTable).
   static const ParameterTable<StaticSceneRegistrationParameters>& table();

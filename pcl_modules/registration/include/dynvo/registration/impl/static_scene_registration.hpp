@@ -9,6 +9,7 @@
 #include <pcl/console/print.h>
 
 #include <cmath>
+#include <stdexcept>
 
 namespace dynvo {
 
@@ -27,6 +28,22 @@ StaticSceneRegistration<PointT>::setParameters(const Parameters& parameters)
 {
   parameters.validate();
   assignParameters(parameters);
+}
+
+template <typename PointT>
+void
+StaticSceneRegistration<PointT>::setSensorNoise(const SensorNoiseModel& noise,
+                                                float focal,
+                                                float axial_gain,
+                                                float lateral_gain)
+{
+  noise.validate();
+  if (!(focal > 0.0f) || !(axial_gain > 0.0f) || !(lateral_gain > 0.0f))
+    throw std::invalid_argument("[dynvo::StaticSceneRegistration::setSensorNoise] "
+                                "focal and gains must be > 0");
+  noise_ = noise;
+  focal_ = focal;
+  noise_gains_ = {axial_gain, lateral_gain};
 }
 
 template <typename PointT>
@@ -224,6 +241,26 @@ StaticSceneRegistration<PointT>::estimateFromFlow()
       break;
     inliers_ = kept;
     inlier_count_ = fit.size();
+  }
+  // docs/algorithm.md §7.2: the kept cells again, each weighed by its information.
+  if (params_.information_iterations > 0) {
+    std::vector<InformationPair> pairs;
+    pairs.reserve(inlier_count_);
+    for (std::size_t i = 0; i < count; ++i)
+      if (inliers_[i])
+        pairs.push_back(
+            {source_points_[i], target_points_[i],
+             noise_
+                 .transferInformation(target_points_[i].cast<float>(),
+                                      source_points_[i].cast<float>(), focal_,
+                                      noise_gains_[0], noise_gains_[1])
+                 .cast<double>(),
+             1.0});
+    if (refineRigidFit(pairs, params_.information_iterations, params_.huber_threshold,
+                       T_prev_curr) != RigidFitStatus::ok)
+      PCL_DEBUG("[dynvo::%s::align] the information-weighted fit is singular; "
+                "the metric fit stays.\n",
+                reg_name_.c_str());
   }
   flow_transformation_ = T_prev_curr.cast<float>();
   return true;
