@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // dynvo_odometry: camera trajectory, moving-object masks and object motions of a recording.
 #include <dynvo/app/pipeline_args.h>
+#include <dynvo/app/reference_odometry.h>
 #include <dynvo/eval/trajectory_metrics.h>
 #include <dynvo/io/label_io.h>
 #include <dynvo/io/trajectory_io.h>
@@ -42,6 +43,7 @@ options()
           {"render_dir", "DIR",
            "render label-coloured views and trajectory.png (needs X: xvfb-run -a)"},
           {"render_every", "N", "render every N-th frame (default 10)"},
+          dynvo::app::referenceOdometryOption(),
       });
 }
 
@@ -125,6 +127,8 @@ main(int argc, char** argv)
     if (dynvo::app::writeConfigIfRequested(args, options))
       return 0;
     const std::size_t max_frames = dynvo::app::maxFramesFromArguments(args);
+    const auto reference =
+        dynvo::app::referenceOdometryFromArguments(args, options.intrinsics);
 
     const std::string groundtruth_path =
         args.has("tum_dir")
@@ -150,12 +154,16 @@ main(int argc, char** argv)
         options, max_frames, *source, outputs,
         [&](const dynvo::Frame& frame, const dynvo::app::FrameResult& result) {
           renderer.add(frame, result, outputs.trajectory());
+          if (reference) // timed on its own, after the pipeline's frame
+            reference->add(frame);
         });
     renderer.finish(outputs.trajectory(), groundtruth);
     end.report.printSummary(
         groundtruth.empty()
             ? ""
             : dynvo::app::RunReport::accuracy(groundtruth, outputs.trajectory()));
+    if (reference)
+      reference->printSummary(end.report.medianMs(), groundtruth);
     return end.loop.error.empty() ? 0 : 1;
   });
 }

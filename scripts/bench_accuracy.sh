@@ -4,10 +4,14 @@
 # Run by hand (not by .ci/run, not a ctest test); it neither installs nor builds: build first with
 # `cmake --build build`. It synthesises the whole development set (every scenario of
 # `dynvo_synthesize -list`, realistic depth noise, one fixed seed), composites every object scenario into
-# the real recording tum_fr1_xyz_200 (when dynvo_synthesize has -composite), and adds that recording as it
-# is. On each sequence it runs dynvo_odometry with -labels_dir and again with -no_segmentation, scores
-# trajectories and labels with dynvo_evaluate, and prints one markdown table (also written to
-# <work>/table.md). Sequences run one after the other; about 200 MB of disk per 300-frame sequence.
+# each real recording of a static scene, tum_fr1_xyz_200 and tum_fr1_desk_fast (when dynvo_synthesize has
+# -composite), and adds the real recordings tum_fr1_xyz_200, tum_fr1_desk_fast and bonn_crowd_people
+# (people walking: no truth masks, so its moving_share is the share of pixels labelled moving, not an
+# error) as they are, each with its own intrinsics. On each sequence it runs dynvo_odometry with
+# -labels_dir and -bench_reference cv_rgbd (OpenCV's RGB-D odometry over the whole image on the same
+# frames: column "RPE cv_rgbd") and again with -no_segmentation, scores trajectories and labels with
+# dynvo_evaluate, and prints one markdown table (also written to <work>/table.md). Sequences run one
+# after the other; about 200 MB of disk per 300-frame sequence.
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"  # ROOT, BUILD and say (defines functions only)
 
 usage() {
@@ -15,10 +19,11 @@ usage() {
 Usage: scripts/bench_accuracy.sh [-frames N] [-only NAME[,NAME...]] [-work DIR] [-seed S] [-force]
 
   -frames N    frames per synthetic sequence (default 300, at least 31: RPE uses a 1 s delta);
-               composites and the real recording use min(N, its frame count)
+               composites and the real recordings use min(N, the recording's frame count)
   -only LIST   comma-separated rows to run: a scenario name selects its synthetic sequence and
-               its composite, tum_fr1_xyz_200+NAME only that composite, tum_fr1_xyz_200 the
-               real recording as it is (default: everything)
+               its composites, RECORDING+NAME only that composite (RECORDING: $(commas $(composite_hosts))),
+               RECORDING the real recording as it is ($(commas "${REALS[@]}"))
+               (default: everything)
   -work DIR    work folder (default \$DYNVO_BENCH_WORK or $BUILD/bench_accuracy); it must be
                empty or absent
   -force       reuse a work folder of an earlier run: deletes only its own synthetic/,
@@ -31,6 +36,19 @@ EOF
 }
 
 die() { printf '\nbench_accuracy.sh: error: %s\n' "$*" >&2; exit 1; }
+
+# --- real recordings (DYNVO_SHARED_DATA_DIR, see its README.md) and their intrinsics flags ---
+REALS=(tum_fr1_xyz_200 tum_fr1_desk_fast bonn_crowd_people)
+declare -A CAMERA=(
+  [tum_fr1_xyz_200]="-camera fr1"
+  [tum_fr1_desk_fast]="-camera fr1"
+  [bonn_crowd_people]="-fx 542.822841 -fy 542.576870 -cx 315.593520 -cy 237.756098"
+)
+# 1: a static scene, into which the object scenarios are composited and which is scored by
+# moving_share (should be near 0); 0: a scene with its own movers.
+declare -A STATIC_SCENE=([tum_fr1_xyz_200]=1 [tum_fr1_desk_fast]=1 [bonn_crowd_people]=0)
+composite_hosts() { local r; for r in "${REALS[@]}"; do [ "${STATIC_SCENE[$r]}" = 0 ] || echo "$r"; done; }
+commas() { local list; list="$(printf '%s, ' "$@")"; printf '%s' "${list%, }"; }  # "a, b, c"
 
 FRAMES=300
 SEED=0
@@ -62,8 +80,6 @@ done
 
 DATA="${DYNVO_SHARED_DATA_DIR:-$ROOT/../shared/data}"
 [ ! -d "$DATA" ] || DATA="$(cd "$DATA" && pwd)"
-REAL_NAME=tum_fr1_xyz_200
-REAL="$DATA/$REAL_NAME"
 
 # --- scenarios: "name  share %  description" after '#' header lines ---
 LIST_OUT="$("$SYNTH" -list)" || die "dynvo_synthesize -list failed (exit $?)"
@@ -82,9 +98,17 @@ declare -A WANT=()
 if [ -n "$ONLY" ]; then
   IFS=',' read -r -a only_names <<<"$ONLY"
   for n in "${only_names[@]}"; do
-    base="${n#"$REAL_NAME"+}"
-    [ "$n" = "$REAL_NAME" ] || [[ " ${SCENARIOS[*]} " == *" $base "* ]] ||
-      die "-only: '$n' is neither a scenario of dynvo_synthesize -list, $REAL_NAME+SCENARIO nor $REAL_NAME"
+    known=0
+    [[ " ${SCENARIOS[*]} " != *" $n "* ]] || known=1
+    [[ " ${REALS[*]} " != *" $n "* ]] || known=1
+    for host in $(composite_hosts); do
+      base="${n#"$host"+}"
+      if [ "$base" != "$n" ] && [ "${HAS_OBJECT[$base]:-0}" = 1 ]; then known=1; fi
+    done
+    [ "$known" = 1 ] ||
+      die "-only: '$n' is neither a scenario of dynvo_synthesize -list, a real recording" \
+          "($(commas "${REALS[@]}")) nor RECORDING+SCENARIO with an object scenario and RECORDING" \
+          "one of $(commas $(composite_hosts))"
     WANT[$n]=1
   done
 fi
@@ -128,19 +152,21 @@ failed_row() {  # label what log
   FAILED+=("$1: $2 (log: ${3#"$WORK"/})")
   printf '    FAILED: %s; see %s\n' "$2" "$3" >&2
   tail -n 5 "$3" | sed 's/^/    | /' >&2 || true
-  ROWS+=("| $1 | FAILED: $2 | | | | | | | | | | | |")
+  ROWS+=("| $1 | FAILED: $2 | | | | | | | | | | | | |")
 }
 
-# Runs odometry twice and both evaluations on SEQ, appends one table row. STATIC=1: a scene without
-# moving objects, also scored by moving_share (on a view of SEQ without labels/ when it has them).
+# Runs odometry twice (the first with the cv_rgbd reference beside it) and both evaluations on SEQ,
+# appends one table row. STATIC=1: a scene without moving objects, also scored by moving_share (on a
+# view of SEQ without labels/ when it has them).
 # run_row LABEL SEQ_DIR STATIC [extra dynvo_odometry args...]
 run_row() {
   local label="$1" seq="$2" static="$3"; shift 3
   local run="$WORK/runs/$label" t0=$SECONDS
   mkdir -p "$run"
-  say "$label: dynvo_odometry -labels_dir, then -no_segmentation"
+  say "$label: dynvo_odometry -labels_dir -bench_reference cv_rgbd, then -no_segmentation"
   if ! "$ODOM" -tum_dir "$seq" -out "$run/trajectory.txt" -labels_dir "$run/labels" \
-       -threads 1 -seed "$SEED" "$@" >"$run/odometry.out" 2>"$run/odometry.err"; then
+       -bench_reference cv_rgbd -threads 1 -seed "$SEED" "$@" >"$run/odometry.out" \
+       2>"$run/odometry.err"; then
     failed_row "$label" "dynvo_odometry" "$run/odometry.err"; return 0
   fi
   if ! "$ODOM" -tum_dir "$seq" -out "$run/trajectory_no_segmentation.txt" -no_segmentation \
@@ -173,14 +199,17 @@ run_row() {
     share="$(grep '^moving_share=' "$run/evaluate_moving_share.out" | tail -n 1)" || true
   fi
 
-  local odo ev evn seg
+  local odo ev evn seg ref refev
   odo="$(grep '^frames=' "$run/odometry.out" | tail -n 1)" || true
+  ref="$(grep '^reference=' "$run/odometry.out" | tail -n 1)" || true
+  refev="$(grep '^reference_rpe_trans_rmse=' "$run/odometry.out" | tail -n 1)" || true
   ev="$(grep '^rpe_trans_rmse=' "$run/evaluate.out" | tail -n 1)" || true
   evn="$(grep '^rpe_trans_rmse=' "$run/evaluate_no_segmentation.out" | tail -n 1)" || true
   seg="$(grep -E '^(moving_iou|moving_share)=' "$run/evaluate_labels.out" | tail -n 1)" || true
   [ -n "$odo" ] || { failed_row "$label" "no 'frames= lost= median_ms=' line from dynvo_odometry" "$run/odometry.out"; return 0; }
   [ -n "$ev" ] && [ -n "$evn" ] || { failed_row "$label" "no rpe_trans_rmse= line from dynvo_evaluate" "$run/evaluate.out"; return 0; }
   [ -n "$seg" ] || { failed_row "$label" "no segmentation line from dynvo_evaluate -labels" "$run/evaluate_labels.out"; return 0; }
+  [ -n "$ref" ] && [ -n "$refev" ] || { failed_row "$label" "no reference= or reference_rpe_trans_rmse= line from dynvo_odometry -bench_reference cv_rgbd" "$run/odometry.out"; return 0; }
 
   local frames lost
   frames="$(kv frames "$odo")"
@@ -189,8 +218,10 @@ run_row() {
 | $(fmt 3 "$(kv moving_iou "$seg")") | $(fmt 3 "$(kv static_precision "$seg")") \
 | $(fmt 3 "$(kv static_recall "$seg")") | $(fmt 3 "$(kv labelled "$seg")") | $(fmt 3 "$(kv bg_ok "$seg")") \
 | $(fmt 3 "$(kv id_switch_rate "$seg")") | $(fmt 3 "$(kv moving_share "$seg $share")") \
-| $(fmt 4 "$(kv rpe_trans_rmse "$evn")") | $(fmt 1 "$(kv median_ms "$odo")") |")
+| $(fmt 4 "$(kv rpe_trans_rmse "$evn")") | $(fmt 4 "$(kv reference_rpe_trans_rmse "$refev")") \
+| $(fmt 1 "$(kv median_ms "$odo")") |")
   printf '    %s\n    %s\n    %s\n' "$ev" "$seg" "$odo"
+  printf '    cv_rgbd: %s\n    cv_rgbd: %s\n' "$refev" "$ref"
   [ -z "$share" ] || printf '    without labels/: %s\n' "$share"
   printf '    -no_segmentation: %s\n' "$evn"
   printf '    %s stderr lines from dynvo_odometry (%s), %d s\n' \
@@ -213,50 +244,57 @@ for s in "${SCENARIOS[@]}"; do
   run_row "$s" "$seq" $((1 - HAS_OBJECT[$s]))
 done
 
-# --- 2. composites into the real recording, 3. the real recording as it is ---
-want_composites=()
-for s in "${SCENARIOS[@]}"; do
-  if [ "${HAS_OBJECT[$s]}" = 1 ] && selected "$REAL_NAME+$s" "$s"; then want_composites+=("$s"); fi
-done
-want_real=0
-if selected "$REAL_NAME"; then want_real=1; fi
-if [ ${#want_composites[@]} -gt 0 ] || [ "$want_real" = 1 ]; then
-  if [ ! -f "$REAL/rgb.txt" ] || [ ! -f "$REAL/depth.txt" ] || [ ! -f "$REAL/groundtruth.txt" ]; then
-    skipped="the ${#want_composites[@]} composite row(s)"
-    [ ${#want_composites[@]} -gt 0 ] || skipped=""
-    [ "$want_real" = 0 ] || skipped="${skipped:+$skipped and }the $REAL_NAME row"
-    say "Skipping $skipped"
-    echo "    no shared data at $REAL (rgb.txt, depth.txt, groundtruth.txt);" \
-         "set DYNVO_SHARED_DATA_DIR to the folder that holds $REAL_NAME/"
-    want_composites=(); want_real=0
-  fi
-fi
-real_frames=0
-[ ! -f "$REAL/rgb.txt" ] || real_frames="$(grep -vc '^#' "$REAL/rgb.txt")" || true
-rframes=$(( FRAMES < real_frames ? FRAMES : real_frames ))  # frames used of the real recording
-if [ ${#want_composites[@]} -gt 0 ]; then
-  if ! "$SYNTH" -h 2>&1 | grep -q -- '-composite'; then
-    say "Skipping the ${#want_composites[@]} composite row(s) (${want_composites[*]}):" \
-        "this dynvo_synthesize has no -composite yet (dynvo_synthesize -h does not list it)"
-  else
-    for s in "${want_composites[@]}"; do
-      label="$REAL_NAME+$s"
-      seq="$WORK/composite/$s"
-      say "$label: dynvo_synthesize -composite $REAL -scenario $s -frames $rframes -seed $SEED -camera fr1"
-      if ! "$SYNTH" -composite "$REAL" -scenario "$s" -out "$seq" -frames "$rframes" -seed "$SEED" \
-           -camera fr1 >"$WORK/runs/composite_$s.log" 2>&1; then
-        failed_row "$label" "dynvo_synthesize -composite $REAL -scenario $s" "$WORK/runs/composite_$s.log"
-        continue
-      fi
-      sed 's/^/    /' "$WORK/runs/composite_$s.log"
-      run_row "$label" "$seq" 0 -camera fr1
+# --- 2. composites into the real recordings of static scenes, 3. the real recordings as they are ---
+HAS_COMPOSITE=0
+if "$SYNTH" -h 2>&1 | grep -q -- '-composite'; then HAS_COMPOSITE=1; fi
+REAL_FRAMES_USED=()  # "name frames" of every real recording used
+for real in "${REALS[@]}"; do
+  real_dir="$DATA/$real"
+  read -r -a camera <<<"${CAMERA[$real]}"
+  want_composites=()
+  if [ "${STATIC_SCENE[$real]}" = 1 ]; then
+    for s in "${SCENARIOS[@]}"; do
+      if [ "${HAS_OBJECT[$s]}" = 1 ] && selected "$real+$s" "$s"; then want_composites+=("$s"); fi
     done
   fi
-fi
-if [ "$want_real" = 1 ]; then
-  # Static scene, no labels/: dynvo_evaluate -labels reports moving_share (should be near 0).
-  run_row "$REAL_NAME" "$REAL" 1 -camera fr1 -max_frames "$rframes"
-fi
+  want_real=0
+  if selected "$real"; then want_real=1; fi
+  [ ${#want_composites[@]} -gt 0 ] || [ "$want_real" = 1 ] || continue
+  if [ ! -f "$real_dir/rgb.txt" ] || [ ! -f "$real_dir/depth.txt" ] || [ ! -f "$real_dir/groundtruth.txt" ]; then
+    skipped="the ${#want_composites[@]} composite row(s) into $real"
+    [ ${#want_composites[@]} -gt 0 ] || skipped=""
+    [ "$want_real" = 0 ] || skipped="${skipped:+$skipped and }the $real row"
+    say "Skipping $skipped"
+    echo "    no shared data at $real_dir (rgb.txt, depth.txt, groundtruth.txt);" \
+         "set DYNVO_SHARED_DATA_DIR to the folder that holds $real/"
+    continue
+  fi
+  real_frames="$(grep -vc '^#' "$real_dir/rgb.txt")" || true
+  rframes=$(( FRAMES < real_frames ? FRAMES : real_frames ))  # frames used of the real recording
+  REAL_FRAMES_USED+=("$real $rframes")
+  if [ ${#want_composites[@]} -gt 0 ] && [ "$HAS_COMPOSITE" = 0 ]; then
+    say "Skipping the ${#want_composites[@]} composite row(s) into $real (${want_composites[*]}):" \
+        "this dynvo_synthesize has no -composite yet (dynvo_synthesize -h does not list it)"
+    want_composites=()
+  fi
+  for s in "${want_composites[@]}"; do
+    label="$real+$s"
+    seq="$WORK/composite/$real/$s"
+    log="$WORK/runs/composite_${real}_$s.log"
+    say "$label: dynvo_synthesize -composite $real_dir -scenario $s -frames $rframes -seed $SEED ${camera[*]}"
+    if ! "$SYNTH" -composite "$real_dir" -scenario "$s" -out "$seq" -frames "$rframes" -seed "$SEED" \
+         "${camera[@]}" >"$log" 2>&1; then
+      failed_row "$label" "dynvo_synthesize -composite $real_dir -scenario $s" "$log"
+      continue
+    fi
+    sed 's/^/    /' "$log"
+    run_row "$label" "$seq" 0 "${camera[@]}"
+  done
+  if [ "$want_real" = 1 ]; then
+    # No labels/: dynvo_evaluate -labels reports moving_share (near 0 on a static scene).
+    run_row "$real" "$real_dir" "${STATIC_SCENE[$real]}" "${camera[@]}" -max_frames "$rframes"
+  fi
+done
 
 # --- table ---
 TOTAL=$((SECONDS - T_START))
@@ -268,13 +306,18 @@ if [ "$(git_state)" != "$COMMIT" ] || [ "$(bins_stamp)" != "$BINS_AT_START" ]; t
 fi
 {
   printf 'dynvo %s, %s: %d frames per synthetic sequence' "$commit" "$(date -u +%Y-%m-%d)" "$FRAMES"
-  [ "$rframes" -eq 0 ] || printf ' (composites and %s: first %d frames)' "$REAL_NAME" "$rframes"
+  if [ ${#REAL_FRAMES_USED[@]} -gt 0 ]; then
+    printf ' (frames used of the real recordings, also for their composites: %s)' \
+      "$(commas "${REAL_FRAMES_USED[@]}")"
+  fi
   printf ', seed %s,' "$SEED"
   printf ' realistic depth noise; RPE: translational RMSE over 1 s, ATE: RMSE after alignment;'
-  printf ' lost: lost/total frames; median ms per frame with segmentation, 1 thread.\n\n'
+  printf ' lost: lost/total frames; RPE cv_rgbd: OpenCV'"'"'s RGB-D odometry frame to frame over the whole'
+  printf ' image on the same frames (dynvo_odometry -bench_reference cv_rgbd);'
+  printf ' median ms per frame with segmentation, 1 thread.\n\n'
   printf '| sequence | RPE m/s | ATE m | lost | moving_iou | static_precision | static_recall | labelled'
-  printf ' | bg_ok | id_switch_rate | moving_share | RPE -no_segmentation | median ms |\n'
-  printf '|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n'
+  printf ' | bg_ok | id_switch_rate | moving_share | RPE -no_segmentation | RPE cv_rgbd | median ms |\n'
+  printf '|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n'
   [ ${#ROWS[@]} -eq 0 ] || printf '%s\n' "${ROWS[@]}"
 } >"$WORK/table.md"
 say "Table ($WORK/table.md)"

@@ -2,6 +2,7 @@
 // dynvo_odometry as users run it: outputs, closing lines, determinism and bad input.
 #include <dynvo/app/object_trajectories.h>
 #include <dynvo/app/pipeline_config.h>
+#include <dynvo/eval/trajectory_metrics.h>
 #include <dynvo/io/image_io.h>
 #include <dynvo/io/label_io.h>
 #include <dynvo/io/trajectory_io.h>
@@ -278,6 +279,76 @@ TEST_F(OdometryApp, CloudsAreLabelledPcdsOfEveryNthFrame)
   EXPECT_EQ(finite_unlabelled, 0u);
 }
 
+/// The value of `key=` in the printed lines as a number (NaN when absent or "nan").
+double
+printedValue(const std::string& out, const std::string& key)
+{
+  std::smatch match;
+  if (!std::regex_search(out, match, std::regex("(^|[ \n])" + key + "=([^ \n]+)")))
+    return std::nan("");
+  return std::stod(match[2].str());
+}
+
+TEST_F(OdometryApp, BenchReferencePrintsItsFiguresAfterTheClosingLines)
+{
+  const auto result =
+      runCommand(run("-out " + out_.file("t.txt") + " -bench_reference cv_rgbd"));
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  // The pipeline's closing line, then the reference's accuracy and its summary, last; the
+  // reference ran on every frame of the run.
+  ASSERT_TRUE(std::regex_search(
+      result.out,
+      std::regex(
+          "\nframes=35 lost=[0-9]+ median_ms=[0-9.]+ mean_ms=[0-9.]+ fps=[0-9.]+\n"
+          "reference_rpe_trans_rmse=[^ ]+ reference_rpe_trans_mean=[^ ]+ "
+          "reference_rpe_rot_rmse=[^ ]+ reference_ate_rmse=[^ ]+ "
+          "reference_pairs=[0-9]+\n"
+          "reference=cv_rgbd frames=35 lost=[0-9]+ median_ms=[^ ]+ "
+          "speed_ratio=[^ ]+\n$")))
+      << result.out;
+  const double pipeline_ms = printedValue(result.out, "median_ms");
+  const std::string reference_line = result.out.substr(result.out.rfind("reference="));
+  const double reference_ms = printedValue(reference_line, "median_ms");
+  const double ratio = printedValue(reference_line, "speed_ratio");
+  ASSERT_GT(pipeline_ms, 0.0);
+  ASSERT_GT(reference_ms,
+            0.0); // a VGA conversion plus OpenCV's pyramids take milliseconds
+  ASSERT_TRUE(std::isfinite(ratio));
+  // The ratio is the pipeline's median over the reference's; both medians are printed to
+  // 0.01 ms of several ms and the ratio to 0.001, hence the slack.
+  EXPECT_NEAR(ratio, pipeline_ms / reference_ms, 0.002) << result.out;
+  EXPECT_GT(printedValue(result.out, "reference_pairs"), 0.0);
+  EXPECT_TRUE(std::isfinite(printedValue(result.out, "reference_rpe_trans_rmse")))
+      << result.out;
+}
+
+TEST_F(OdometryApp, BenchReferenceFollowsAMovingCamera)
+{
+  // The static room seen by a moving camera: OpenCV's dense odometry has every pixel of a
+  // rigid scene, so it must follow the camera. A reference composed the wrong way, or one
+  // that never moves, is off by the camera's whole motion or twice it: its RPE is at least
+  // that of poses standing still, the camera's own speed (about 0.1-0.3 m/s here). OpenCV's
+  // floor on these noisy synthetic rooms is a few cm/s, so half of that speed separates the
+  // two with room on both sides.
+  const int frames = 35; // over 1 s at 30 Hz, so that RPE has pairs
+  const dynvo::test::SyntheticSequence moving("moving_static", frames, 640, 480);
+  const auto result = runCommand(app_ + " -tum_dir " + moving.path() + " -out " +
+                                 out_.file("t.txt") + " -bench_reference cv_rgbd");
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const auto groundtruth = dynvo::readTrajectory(moving.path() + "/groundtruth.txt");
+  dynvo::Trajectory standing = dynvo::readTrajectory(out_.file("t.txt"));
+  ASSERT_EQ(standing.size(), static_cast<std::size_t>(frames));
+  for (auto& pose : standing)
+    pose.T_world_camera = Eigen::Isometry3d::Identity();
+  const double still = dynvo::computeRpe(groundtruth, standing).trans_rmse;
+  ASSERT_GT(still, 0.05) << "the camera must move for this test to mean anything";
+  const double reference = printedValue(result.out, "reference_rpe_trans_rmse");
+  EXPECT_LT(reference, 0.5 * still) << result.out;
+  // Every frame of a textured rigid scene gives OpenCV enough pixels.
+  EXPECT_NE(result.out.find("reference=cv_rgbd frames=35 lost=0 "), std::string::npos)
+      << result.out;
+}
+
 /// Runs of consecutive frames per id in an objects file: id -> (first, last frame
 /// index).
 std::multimap<int, std::pair<std::size_t, std::size_t>>
@@ -389,6 +460,12 @@ TEST_F(OdometryApp, BadFlagsAndMissingInput)
   EXPECT_NE(backend.err.find("-backend must be flow|cv_rgbd|icp|gicp, got 'lm'"),
             std::string::npos)
       << backend.err;
+  const auto reference = runCommand(run("-bench_reference orb"));
+  EXPECT_EQ(reference.exit_code, 2);
+  EXPECT_NE(reference.err.find("-bench_reference must be cv_rgbd, got 'orb'"),
+            std::string::npos)
+      << reference.err;
+  EXPECT_EQ(runCommand(run("-bench_reference")).exit_code, 2); // no value
   EXPECT_EQ(runCommand(run("-threads 0")).exit_code, 2);
   const auto every =
       runCommand(run("-clouds_dir " + out_.file("c") + " -clouds_every 0"));

@@ -19,20 +19,6 @@ namespace dynvo::app {
 
 namespace fs = std::filesystem;
 
-namespace {
-
-double
-median(std::vector<double> values)
-{
-  if (values.empty())
-    return 0.0;
-  const auto middle = values.begin() + values.size() / 2;
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
-}
-
-} // namespace
-
 RunOutputs::RunOutputs(const RunOutputPaths& paths,
                        const Trajectory* initial_groundtruth)
     : paths_(paths)
@@ -198,6 +184,22 @@ RunReport::add(const FrameResult& result)
   }
 }
 
+double
+median(std::vector<double> values)
+{
+  if (values.empty())
+    return 0.0;
+  const auto middle = values.begin() + values.size() / 2;
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
+double
+RunReport::medianMs() const
+{
+  return median(total_ms_);
+}
+
 void
 RunReport::printSummary(const std::string& accuracy) const
 {
@@ -212,7 +214,7 @@ RunReport::printSummary(const std::string& accuracy) const
   if (!accuracy.empty())
     std::printf("%s\n", accuracy.c_str());
   std::printf("frames=%zu lost=%zu median_ms=%.2f mean_ms=%.2f fps=%.1f\n", frames_,
-              lost_, median(total_ms_), mean, mean > 0.0 ? 1000.0 / mean : 0.0);
+              lost_, medianMs(), mean, mean > 0.0 ? 1000.0 / mean : 0.0);
 }
 
 std::string

@@ -97,6 +97,9 @@ private:
   ObjectTrajectories object_trajectories_;
 };
 
+/// The median of the values (the upper middle one of an even count); 0 when empty.
+DYNVO_EXPORTS double median(std::vector<double> values);
+
 /// Progress bar on a terminal, per-frame timings, and the closing lines of a run.
 class DYNVO_EXPORTS RunReport {
 public:
@@ -108,6 +111,9 @@ public:
 
   /// Frames recorded.
   std::size_t frames() const { return frames_; }
+
+  /// Median time per frame after frame 0 (ms, decoding excluded); 0 before the second frame.
+  double medianMs() const;
 
   /// Prints the per-stage medians, then `accuracy` when not empty, and last
   /// "frames=<n> lost=<n> median_ms=<x> mean_ms=<x> fps=<x>" (per frame, decoding excluded).

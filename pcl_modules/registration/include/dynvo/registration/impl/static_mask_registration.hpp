@@ -2,7 +2,7 @@
 // Template bodies of StaticMaskRegistration (compiled in src/ for XYZRGB and XYZRGBA).
 #pragma once
 
-#include <dynvo/common/image.h>
+#include <dynvo/common/conventions.h>
 #include <dynvo/registration/rgbd_odometry.h>
 #include <dynvo/registration/rigid_refinement.h>
 #include <dynvo/registration/static_mask_registration.h>
@@ -12,7 +12,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <vector>
 
 namespace dynvo {
@@ -49,26 +48,6 @@ maskedLatticePoints(const pcl::PointCloud<PointT>& cloud,
         points->push_back(pcl::PointXYZ(p.x, p.y, p.z));
     }
   return points;
-}
-
-/// Gray image (ITU-R BT.601 luma), depth (z, NaN where none) and mask of a cloud.
-template <typename PointT>
-RgbdImage
-rgbdImageOf(const pcl::PointCloud<PointT>& cloud, std::vector<std::uint8_t> mask)
-{
-  RgbdImage image;
-  image.width = cloud.width;
-  image.height = cloud.height;
-  image.gray.resize(cloud.size());
-  image.depth.resize(cloud.size());
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    const PointT& p = cloud[i];
-    image.gray[i] = luma(p.r, p.g, p.b);
-    image.depth[i] =
-        pcl::isXYZFinite(p) ? p.z : std::numeric_limits<float>::quiet_NaN();
-  }
-  image.mask = std::move(mask);
-  return image;
 }
 
 } // namespace detail
