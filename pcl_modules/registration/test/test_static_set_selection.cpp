@@ -158,6 +158,28 @@ TEST_F(Selection, MotionGuardOverridesABackgroundLabelOnTheMovingBox)
   EXPECT_GT(translationError(registration_.getFinalTransformation(), truth()), 0.03);
 }
 
+TEST_F(Selection, IntermediateFitsLeaveTheRefinementSettingAsItWas)
+{
+  // The first fit and the guard's fit choose cells with the metric fit; the registration's
+  // information-weighted refinement is switched off for them and must be back for the
+  // caller afterwards, whichever path align() took (swapped labels: the guard path).
+  registration_.setInformationIterations(3);
+  FlowGrid labels = trueLabels();
+  for (auto& label : labels.labels)
+    label = label == LABEL_OBJECT   ? LABEL_STATIC
+            : label == LABEL_STATIC ? LABEL_OBJECT
+                                    : label;
+  selection_.setCellLabels(labels);
+  ASSERT_TRUE(selection_.align(registration_));
+  EXPECT_FALSE(selection_.getLabelsTrusted());
+  EXPECT_EQ(registration_.getInformationIterations(), 3);
+  expectTruth();
+  selection_.setCellLabels(trueLabels());
+  ASSERT_TRUE(selection_.align(registration_));
+  EXPECT_EQ(registration_.getInformationIterations(), 3);
+  expectTruth();
+}
+
 TEST_F(Selection, WithoutLabelsEveryValidCellIsStatic)
 {
   selection_.clearCellLabels();

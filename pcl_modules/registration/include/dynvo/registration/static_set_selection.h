@@ -121,8 +121,10 @@ private:
   /// Stores checked parameters.
   void assignParameters(const Parameters& parameters) { params_ = parameters; }
 
-  /// Sets static_cells_ on the registration and fits from T_prev_curr_guess.
-  bool fit(Registration& registration, const Eigen::Matrix4d& T_prev_curr_guess);
+  /// Sets static_cells_ on the registration and fits from T_prev_curr_guess; only a final
+  /// fit keeps the registration's information-weighted refinement.
+  bool
+  fit(Registration& registration, const Eigen::Matrix4d& T_prev_curr_guess, bool final);
 
   /// Marks in static_cells_ the valid cells whose flow agrees with T_prev_curr within limit
   /// (squared transfer error of b_i onto a_i, m^2), leaving out the cells labelled as

@@ -10,8 +10,18 @@ namespace dynvo {
 template <typename PointT>
 bool
 StaticSetSelection<PointT>::fit(Registration& registration,
-                                const Eigen::Matrix4d& T_prev_curr_guess)
+                                const Eigen::Matrix4d& T_prev_curr_guess,
+                                bool final)
 {
+  // docs/algorithm.md §7.2: the cells are chosen with the metric fit; only the final fit is
+  // refined under the sensor's noise (its iterations are restored however align() ends).
+  struct Iterations {
+    Registration& registration;
+    const int kept = registration.getInformationIterations();
+    ~Iterations() { registration.setInformationIterations(kept); }
+  } iterations{registration};
+  if (!final)
+    registration.setInformationIterations(0);
   registration.setStaticCells(static_cells_);
   typename Registration::PointCloud aligned;
   registration.align(aligned, T_prev_curr_guess.cast<float>());
@@ -47,12 +57,12 @@ StaticSetSelection<PointT>::align(Registration& registration)
       !FlowGrid::fromFlow(*flow, source->width, source->height, static_cells_)) {
     // The registration reports the broken input.
     static_cells_ = FlowGrid();
-    return fit(registration, rigidInverse(T_curr_prev_predicted_));
+    return fit(registration, rigidInverse(T_curr_prev_predicted_), true);
   }
   if (!use_labels_) {
     for (std::size_t i = 0; i < flow->size(); ++i)
       static_cells_.labels[i] = (*flow)[i].valid_3d ? LABEL_STATIC : LABEL_NONE;
-    return fit(registration, rigidInverse(T_curr_prev_predicted_));
+    return fit(registration, rigidInverse(T_curr_prev_predicted_), true);
   }
   const bool labels_fit = labels_.sameGeometry(static_cells_) &&
                           labels_.labels.size() == static_cells_.size();
@@ -61,7 +71,8 @@ StaticSetSelection<PointT>::align(Registration& registration)
         labels_.labels[i] == LABEL_STATIC ? LABEL_STATIC : LABEL_NONE;
 
   const Eigen::Matrix4d T_prev_curr_predicted = rigidInverse(T_curr_prev_predicted_);
-  const bool background_fit = fit(registration, T_prev_curr_predicted);
+  const bool background_fit =
+      fit(registration, T_prev_curr_predicted, !(params_.static_consensus > 0.0f));
   Eigen::Matrix4d T_prev_curr =
       registration.getFinalTransformation().template cast<double>();
   if (!(params_.static_consensus > 0.0f))
@@ -72,13 +83,13 @@ StaticSetSelection<PointT>::align(Registration& registration)
   labels_trusted_ = labels_fit && background_fit && departure <= tau;
   if (!labels_trusted_) {
     selectConsensus(*flow, T_prev_curr_predicted, false, tau * tau);
-    T_prev_curr = fit(registration, T_prev_curr_predicted)
+    T_prev_curr = fit(registration, T_prev_curr_predicted, false)
                       ? registration.getFinalTransformation().template cast<double>()
                       : T_prev_curr_predicted;
   }
   selectConsensus(*flow, T_prev_curr, labels_trusted_,
                   static_cast<double>(params_.static_consensus) * inlier_threshold_);
-  return fit(registration, T_prev_curr);
+  return fit(registration, T_prev_curr, true);
 }
 
 } // namespace dynvo
