@@ -53,6 +53,17 @@ protected:
     return labels;
   }
 
+  /// The true labels swapped: the moving box "static", the background an object.
+  FlowGrid swappedLabels() const
+  {
+    FlowGrid labels = trueLabels();
+    for (auto& label : labels.labels)
+      label = label == LABEL_OBJECT   ? LABEL_STATIC
+              : label == LABEL_STATIC ? LABEL_OBJECT
+                                      : label;
+    return labels;
+  }
+
   Eigen::Matrix4d truth() const { return scene_.T_curr_prev.inverse().matrix(); }
 
   void expectTruth()
@@ -142,12 +153,7 @@ TEST_F(Selection, MotionGuardOverridesABackgroundLabelOnTheMovingBox)
   // Labels swapped: the moving box is "static", the background an object. The first fit
   // follows the box, 13 cm away from H_pred > tau_cv = 3 cm: the guard fits on the cells
   // that agree with H_pred instead and does not trust the labels.
-  FlowGrid labels = trueLabels();
-  for (auto& label : labels.labels)
-    label = label == LABEL_OBJECT   ? LABEL_STATIC
-            : label == LABEL_STATIC ? LABEL_OBJECT
-                                    : label;
-  selection_.setCellLabels(labels);
+  selection_.setCellLabels(swappedLabels());
   ASSERT_TRUE(selection_.align(registration_));
   EXPECT_FALSE(selection_.getLabelsTrusted());
   expectTruth();
@@ -164,12 +170,7 @@ TEST_F(Selection, IntermediateFitsLeaveTheRefinementSettingAsItWas)
   // information-weighted refinement is switched off for them and must be back for the
   // caller afterwards, whichever path align() took (swapped labels: the guard path).
   registration_.setInformationIterations(3);
-  FlowGrid labels = trueLabels();
-  for (auto& label : labels.labels)
-    label = label == LABEL_OBJECT   ? LABEL_STATIC
-            : label == LABEL_STATIC ? LABEL_OBJECT
-                                    : label;
-  selection_.setCellLabels(labels);
+  selection_.setCellLabels(swappedLabels());
   ASSERT_TRUE(selection_.align(registration_));
   EXPECT_FALSE(selection_.getLabelsTrusted());
   EXPECT_EQ(registration_.getInformationIterations(), 3);
