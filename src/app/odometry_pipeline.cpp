@@ -369,6 +369,7 @@ struct OdometryPipeline::Impl {
   Eigen::Matrix4d last_step =
       Eigen::Matrix4d::Identity(); ///< T_curr_prev of the last frame
   double step_dt = 1.0 / 30.0;     ///< this frame's interval (s), the bound's duration
+  double last_colour_dt = 1.0 / 30.0; ///< the last positive colour interval (s)
   std::size_t frames = 0;
   FrameResult result;
 };
@@ -422,14 +423,24 @@ OdometryPipeline::process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& clo
     result.motions.assign(1, Eigen::Matrix4f::Identity());
   }
   else {
-    // Constant velocity, within the motion bound. The bound holds over the longer of the
-    // colour and depth intervals (TUM fr1 drops colour and depth frames at different
-    // instants); an interval that is not positive (stamps not increasing) counts as the last.
-    const double dt =
-        std::max(timestamp - p.previous_stamp, depth_stamp - p.previous_depth_stamp);
+    // Constant velocity over time (docs/algorithm.md §7.5): the last step scaled by the
+    // ratio of the colour intervals (a dropped frame doubles the step), within the motion
+    // bound. The bound holds over the longer of the colour and depth intervals (TUM fr1 drops
+    // colour and depth frames at different instants); an interval that is not positive
+    // (stamps not increasing) counts as the last one.
+    const double colour_dt = timestamp - p.previous_stamp;
+    const double dt = std::max(colour_dt, depth_stamp - p.previous_depth_stamp);
     p.step_dt = std::isfinite(dt) && dt > 0.0 ? dt : p.step_dt;
-    const double share = shareWithinBound(p.last_step, p.step_dt, p.options);
-    p.T_curr_prev_predicted = share < 1.0 ? scaleStep(p.last_step, share) : p.last_step;
+    const double ratio = std::isfinite(colour_dt) && colour_dt > 0.0
+                             ? colour_dt / p.last_colour_dt
+                             : 1.0;
+    const Eigen::Matrix4d velocity_step =
+        ratio != 1.0 ? scaleStep(p.last_step, ratio) : p.last_step;
+    const double share = shareWithinBound(velocity_step, p.step_dt, p.options);
+    p.T_curr_prev_predicted =
+        share < 1.0 ? scaleStep(velocity_step, share) : velocity_step;
+    if (std::isfinite(colour_dt) && colour_dt > 0.0)
+      p.last_colour_dt = colour_dt;
     p.track(cloud);
     result.T_world_curr = p.T_world_prev * rigidInverse(result.T_curr_prev);
     // The keyframe fit is the flow backend's; the other backends run frame to frame.
@@ -437,8 +448,10 @@ OdometryPipeline::process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& clo
       p.trackKeyframe(cloud);
       result.T_curr_prev = rigidInverse(result.T_world_curr) * p.T_world_prev;
     }
-    if (p.frames % 100 == 0)
-      orthonormalize(result.T_world_curr);
+    // Every pose is rigid: a product that drifts off SO(3) makes rigidInverse() inexact, and
+    // the last step, taken from two poses, feeds the error back through the prediction on
+    // lost frames until it diverges (docs/algorithm.md §7.5).
+    orthonormalize(result.T_world_curr);
     p.last_step = result.T_curr_prev;
   }
   result.labels = paintLabelImage(result.segments, result.segment_labels, result.width,
