@@ -29,7 +29,7 @@ enum class StaticRegistrationStatus {
   invalid_input, ///< the inputs broke the contract (logged with PCL_ERROR); not converged
   too_few_correspondences, ///< fewer than min_correspondences usable static cells; not converged
   degenerate,              ///< the static cells are (nearly) collinear; not converged
-  converged ///< the result is the trimmed flow estimate
+  converged                ///< the result is the trimmed flow estimate
 };
 
 /** \brief Camera ego-motion from the static cells of a grid scene flow: Lee, Son & Kim, "Robust
@@ -183,14 +183,12 @@ public:
 
   /** \brief The depth camera's noise for the information-weighted fit (docs/algorithm.md
    * §7.2): each kept cell's transfer error is weighed by
-   * noise.transferInformation(a_i, b_i, focal, axial_gain, lateral_gain).
-   * Defaults: SensorNoiseModel(), focal 525 px (Kinect v1), gains 1.
-   * \throws std::invalid_argument when noise.validate() fails or a number is not > 0
+   * noise.transferInformation(a_i, b_i, focal) (the model's gains of 1: the segmentation's
+   * fitted gains were measured here and not kept, src/app/NOTES.md).
+   * Defaults: SensorNoiseModel(), focal 525 px (Kinect v1).
+   * \throws std::invalid_argument when noise.validate() fails or focal is not > 0
    */
-  void setSensorNoise(const SensorNoiseModel& noise,
-                      float focal,
-                      float axial_gain = 1.0f,
-                      float lateral_gain = 1.0f);
+  void setSensorNoise(const SensorNoiseModel& noise, float focal);
 
 protected:
   using Base::converged_;
@@ -234,7 +232,6 @@ private:
   Parameters params_;                    ///< validated knobs
   SensorNoiseModel noise_;               ///< setSensorNoise()
   float focal_ = 525.0f;                 ///< focal length of the noise model (px)
-  std::array<float, 2> noise_gains_{1.0f, 1.0f}; ///< {axial, lateral} gains
   FlowCloudConstPtr flow_;               ///< grid scene flow k-1 -> k
   Status status_ = Status::not_computed; ///< outcome of the last align()
   double mean_squared_residual_ =

@@ -33,17 +33,14 @@ StaticSceneRegistration<PointT>::setParameters(const Parameters& parameters)
 template <typename PointT>
 void
 StaticSceneRegistration<PointT>::setSensorNoise(const SensorNoiseModel& noise,
-                                                float focal,
-                                                float axial_gain,
-                                                float lateral_gain)
+                                                float focal)
 {
   noise.validate();
-  if (!(focal > 0.0f) || !(axial_gain > 0.0f) || !(lateral_gain > 0.0f))
+  if (!(focal > 0.0f))
     throw std::invalid_argument("[dynvo::StaticSceneRegistration::setSensorNoise] "
-                                "focal and gains must be > 0");
+                                "focal must be > 0");
   noise_ = noise;
   focal_ = focal;
-  noise_gains_ = {axial_gain, lateral_gain};
 }
 
 template <typename PointT>
@@ -252,8 +249,7 @@ StaticSceneRegistration<PointT>::estimateFromFlow()
             {source_points_[i], target_points_[i],
              noise_
                  .transferInformation(target_points_[i].cast<float>(),
-                                      source_points_[i].cast<float>(), focal_,
-                                      noise_gains_[0], noise_gains_[1])
+                                      source_points_[i].cast<float>(), focal_)
                  .cast<double>(),
              1.0});
     if (refineRigidFit(pairs, params_.information_iterations, params_.huber_threshold,
