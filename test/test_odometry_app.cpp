@@ -2,6 +2,7 @@
 // dynvo_odometry as users run it: outputs, closing lines, determinism and bad input.
 #include <dynvo/app/object_trajectories.h>
 #include <dynvo/app/pipeline_config.h>
+#include <dynvo/app/run_report.h>
 #include <dynvo/eval/trajectory_metrics.h>
 #include <dynvo/io/image_io.h>
 #include <dynvo/io/label_io.h>
@@ -237,6 +238,17 @@ TEST_F(OdometryApp, FramesReportSaysWhichFramesWereLostAndWhy)
   EXPECT_GE(std::stol(rows[11][5]), 1);
   EXPECT_LE(std::stol(rows[11][5]), 9);
   EXPECT_FALSE(fs::exists(out_.file("frames.tsv.partial")));
+}
+
+TEST(FramesReport, ARecoveredFrameIsNotLostAndSaysHowItWasMeasured)
+{
+  dynvo::app::FrameResult result;
+  result.timestamp = 12.5;
+  result.recovered = true;
+  const std::string line = dynvo::app::formatFrameReportLine(result);
+  EXPECT_EQ(line.substr(0, line.find('\t', line.find('\t', line.find('\t') + 1) + 1)),
+            "12.500000\t0\trecovered_dense")
+      << line;
 }
 
 TEST_F(OdometryApp, CloudsAreLabelledPcdsOfEveryNthFrame)

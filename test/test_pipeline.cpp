@@ -5,6 +5,7 @@
 #include <dynvo/common/trajectory.h>
 #include <dynvo/eval/trajectory_metrics.h>
 #include <dynvo/io/frame.h>
+#include <dynvo/io/trajectory_io.h>
 #include <dynvo/io/tum_folder_source.h>
 #include <dynvo/synth/scene_synthesizer.h>
 
@@ -583,6 +584,15 @@ TEST(OdometryPipeline, InlierThresholdFollowsTheMeasuredNoise)
   }
 }
 
+/// Reading options of a TUM fr1 recording: the fr1 camera.
+dynvo::TumFolderSource::Options
+fr1SourceOptions()
+{
+  dynvo::TumFolderSource::Options options;
+  options.intrinsics = dynvo::CameraIntrinsics::fromPreset("fr1");
+  return options;
+}
+
 TEST(OdometryPipeline, InlierThresholdStaysLooseOnRealKinectFrames)
 {
   // TUM fr1/xyz: colour and depth are not taken at the same instant, and the hand-held camera
@@ -590,11 +600,9 @@ TEST(OdometryPipeline, InlierThresholdStaysLooseOnRealKinectFrames)
   // keeps the threshold well above the lower bound (measured values: src/app/NOTES.md).
   const std::string folder = dynvo::test::sharedDataPath("tum_fr1_xyz_200");
   DYNVO_REQUIRE_SHARED_DATA(folder + "/rgb.txt");
-  dynvo::TumFolderSource::Options source_options;
-  source_options.intrinsics = dynvo::CameraIntrinsics::fromPreset("fr1");
-  dynvo::TumFolderSource source(folder, source_options);
+  dynvo::TumFolderSource source(folder, fr1SourceOptions());
   dynvo::app::PipelineOptions options;
-  options.intrinsics = source_options.intrinsics;
+  options.intrinsics = fr1SourceOptions().intrinsics;
   dynvo::app::OdometryPipeline pipeline(options);
   dynvo::Frame frame;
   double sum = 0.0;
@@ -610,6 +618,47 @@ TEST(OdometryPipeline, InlierThresholdStaysLooseOnRealKinectFrames)
   ASSERT_EQ(frames, 30);
   RecordProperty("mean_inlier_threshold", std::to_string(sum / frames));
   EXPECT_GT(sum / frames, 1.5 * options.inlier_noise.min_inlier_threshold);
+}
+
+TEST(OdometryPipeline, FastFrameNoFlowFitMeasuresIsRecoveredByTheDenseFit)
+{
+  // TUM fr1/desk, fast hand-held: after a 68 ms gap, a blurred frame leaves neither flow fit
+  // enough static cells. OpenCV's dense RGB-D odometry on the previous frame's static mask
+  // measures it instead of the constant-velocity prediction.
+  const std::string folder = dynvo::test::sharedDataPath("tum_fr1_desk_fast");
+  DYNVO_REQUIRE_SHARED_DATA(folder + "/groundtruth.txt");
+  dynvo::TumFolderSource source(folder, fr1SourceOptions());
+  const dynvo::Trajectory truth = dynvo::readTrajectory(folder + "/groundtruth.txt");
+  dynvo::app::PipelineOptions options;
+  options.intrinsics = fr1SourceOptions().intrinsics;
+  dynvo::app::OdometryPipeline pipeline(options);
+  dynvo::Frame frame;
+  Eigen::Isometry3d T_world_prev = Eigen::Isometry3d::Identity();
+  double prev_stamp = 0.0;
+  int recovered = 0;
+  while (source.next(frame)) {
+    const auto& result =
+        pipeline.process(frame.cloud, frame.timestamp, frame.depth_timestamp);
+    const Eigen::Isometry3d T_world_curr(result.T_world_curr);
+    if (result.recovered) {
+      ++recovered;
+      EXPECT_FALSE(result.lost);
+      const auto truth_prev = dynvo::interpolatePose(truth, prev_stamp, 0.25);
+      const auto truth_curr = dynvo::interpolatePose(truth, frame.timestamp, 0.25);
+      ASSERT_TRUE(truth_prev && truth_curr);
+      const Eigen::Vector3d step =
+          (T_world_prev.inverse() * T_world_curr).translation();
+      const Eigen::Vector3d true_step =
+          (truth_prev->inverse() * *truth_curr).translation();
+      // The measured frames of this clip are off the ground truth's step by 13 mm (median,
+      // src/app/NOTES.md); the prediction was off by 28 mm on the frame this test was written
+      // on (a 68 ms step of 33 mm): a recovered step is as good as a measured one.
+      EXPECT_LT((step - true_step).norm(), 0.015) << "frame at " << frame.timestamp;
+    }
+    T_world_prev = T_world_curr;
+    prev_stamp = frame.timestamp;
+  }
+  EXPECT_GE(recovered, 1);
 }
 
 TEST(OdometryPipeline, NoiseFollowingThresholdBoundsAreValidated)

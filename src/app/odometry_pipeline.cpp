@@ -168,6 +168,10 @@ struct OdometryPipeline::Impl {
     noise_tracker.setUpperBound(options.segmentation.inlier_threshold);
     backend.setParameters(options.backend);
     backend.setCameraIntrinsics(options.intrinsics);
+    StaticMaskRegistrationParameters dense = options.backend;
+    dense.backend = RegistrationBackend::cv_rgbd;
+    recovery.setParameters(dense);
+    recovery.setCameraIntrinsics(options.intrinsics);
   }
 
   /// Why the frame cannot be processed, or empty when it can.
@@ -239,6 +243,8 @@ struct OdometryPipeline::Impl {
             ? T_curr_prev_predicted
             : rigidInverse(registration.getFinalTransformation().cast<double>());
     alignOnStaticMask(cloud);
+    if (!result.lost)
+      previous_static_cells = selection.getStaticCells();
     result.times.registration_ms = millisecondsSince(registration_start);
   }
 
@@ -340,7 +346,43 @@ struct OdometryPipeline::Impl {
       backend.align(registration.getFinalTransformation(), T_prev_curr);
       result.T_curr_prev = rigidInverse(T_prev_curr.cast<double>());
     }
-    previous_static_cells = static_cells;
+  }
+
+  /** A frame that no flow fit measured (docs/algorithm.md §7.5): OpenCV's dense RGB-D
+   * odometry against the previous frame on its static mask (both frames), from the
+   * prediction. Taken when it converges within the motion bound and within tau_cv of the
+   * prediction: sets result.T_curr_prev and
+   * result.T_world_curr, clears result.lost and sets result.recovered.
+   */
+  void recoverDense(const Cloud::ConstPtr& cloud)
+  {
+    if (previous_static_cells.size() == 0)
+      return;
+    const auto start = Clock::now();
+    recovery.setInputSource(cloud);
+    recovery.setInputTarget(previous);
+    recovery.setSourceStaticCells(previous_static_cells);
+    recovery.setTargetStaticCells(previous_static_cells);
+    Eigen::Matrix4f T_prev_curr;
+    if (recovery.align(rigidInverse(T_curr_prev_predicted).cast<float>(),
+                       T_prev_curr)) {
+      const Eigen::Matrix4d T_curr_prev = rigidInverse(T_prev_curr.cast<double>());
+      // A blurred frame can pull the dense fit far: it may depart from the prediction by no
+      // more than tau_cv, the segmentation's background guard (the flow fits' wider
+      // tolerance grows with the predicted motion of the points, 19 cm on a fast turn).
+      const double departure = (T_curr_prev_predicted * T_prev_curr.cast<double>())
+                                   .topRightCorner<3, 1>()
+                                   .norm();
+      if (withinBound(T_curr_prev) &&
+          departure <= options.segmentation.static_guard_tolerance) {
+        result.T_curr_prev = T_curr_prev;
+        result.T_world_curr = T_world_prev * T_prev_curr.cast<double>();
+        result.lost = false;
+        result.lost_reason = LostReason::none;
+        result.recovered = true;
+      }
+    }
+    result.times.registration_ms += millisecondsSince(start);
   }
 
   PipelineOptions options;
@@ -357,8 +399,10 @@ struct OdometryPipeline::Impl {
   StaticSetSelection<pcl::PointXYZRGB> selection;
   InlierNoiseTracker noise_tracker;
   StaticMaskRegistration<pcl::PointXYZRGB> backend;
-  FlowGrid
-      previous_static_cells; ///< the static set of the previous frame (the backend's)
+  StaticMaskRegistration<pcl::PointXYZRGB>
+      recovery; ///< dense, for frames no fit measured
+  /// the static set of the last measured frame (the backend's and the recovery's masks)
+  FlowGrid previous_static_cells;
   Cloud::ConstPtr previous;
   Eigen::Matrix4d T_world_prev =
       Eigen::Matrix4d::Identity();   ///< at the previous frame's depth instant
@@ -448,6 +492,8 @@ OdometryPipeline::process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& clo
       p.trackKeyframe(cloud);
       result.T_curr_prev = rigidInverse(result.T_world_curr) * p.T_world_prev;
     }
+    if (result.lost)
+      p.recoverDense(cloud);
     // Every pose is rigid: a product that drifts off SO(3) makes rigidInverse() inexact, and
     // the last step, taken from two poses, feeds the error back through the prediction on
     // lost frames until it diverges (docs/algorithm.md §7.5).

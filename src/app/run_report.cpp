@@ -117,13 +117,13 @@ formatFrameReportLine(const FrameResult& result)
   const double share =
       labelled > 0 ? static_cast<double>(moving) / static_cast<double>(labelled) : 0.0;
   char line[256];
-  std::snprintf(line, sizeof(line),
-                "%s\t%d\t%s\t%zu\t%.3e\t%ld\t%.4f\t%.2f\t%.2f\t%.2f\t%.2f",
-                formatStamp(result.timestamp).c_str(), result.lost ? 1 : 0,
-                lostReasonName(result.lost_reason), result.static_cells,
-                result.residual, result.keyframe_index, share,
-                result.times.scene_flow_ms, result.times.segmentation_ms,
-                result.times.registration_ms, result.times.total_ms);
+  std::snprintf(
+      line, sizeof(line), "%s\t%d\t%s\t%zu\t%.3e\t%ld\t%.4f\t%.2f\t%.2f\t%.2f\t%.2f",
+      formatStamp(result.timestamp).c_str(), result.lost ? 1 : 0,
+      result.recovered ? "recovered_dense" : lostReasonName(result.lost_reason),
+      result.static_cells, result.residual, result.keyframe_index, share,
+      result.times.scene_flow_ms, result.times.segmentation_ms,
+      result.times.registration_ms, result.times.total_ms);
   return line;
 }
 
