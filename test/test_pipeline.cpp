@@ -620,45 +620,72 @@ TEST(OdometryPipeline, InlierThresholdStaysLooseOnRealKinectFrames)
   EXPECT_GT(sum / frames, 1.5 * options.inlier_noise.min_inlier_threshold);
 }
 
-TEST(OdometryPipeline, FastFrameNoFlowFitMeasuresIsRecoveredByTheDenseFit)
+/// The pipeline's trajectory over a TUM fr1 recording (default options as `configure`
+/// leaves them), which frames were lost and which the dense fit recovered.
+struct RecordingRun {
+  dynvo::Trajectory estimate;
+  std::vector<bool> lost;
+  std::vector<bool> recovered;
+};
+
+RecordingRun
+runFr1Recording(const std::string& folder, const Configure& configure = {})
 {
-  // TUM fr1/desk, fast hand-held: after a 68 ms gap, a blurred frame leaves neither flow fit
-  // enough static cells. OpenCV's dense RGB-D odometry on the previous frame's static mask
-  // measures it instead of the constant-velocity prediction.
-  const std::string folder = dynvo::test::sharedDataPath("tum_fr1_desk_fast");
-  DYNVO_REQUIRE_SHARED_DATA(folder + "/groundtruth.txt");
   dynvo::TumFolderSource source(folder, fr1SourceOptions());
-  const dynvo::Trajectory truth = dynvo::readTrajectory(folder + "/groundtruth.txt");
   dynvo::app::PipelineOptions options;
   options.intrinsics = fr1SourceOptions().intrinsics;
+  if (configure)
+    configure(options);
   dynvo::app::OdometryPipeline pipeline(options);
+  RecordingRun run;
   dynvo::Frame frame;
-  Eigen::Isometry3d T_world_prev = Eigen::Isometry3d::Identity();
-  double prev_stamp = 0.0;
-  int recovered = 0;
   while (source.next(frame)) {
     const auto& result =
         pipeline.process(frame.cloud, frame.timestamp, frame.depth_timestamp);
-    const Eigen::Isometry3d T_world_curr(result.T_world_curr);
-    if (result.recovered) {
-      ++recovered;
-      EXPECT_FALSE(result.lost);
-      const auto truth_prev = dynvo::interpolatePose(truth, prev_stamp, 0.25);
-      const auto truth_curr = dynvo::interpolatePose(truth, frame.timestamp, 0.25);
-      ASSERT_TRUE(truth_prev && truth_curr);
-      const Eigen::Vector3d step =
-          (T_world_prev.inverse() * T_world_curr).translation();
-      const Eigen::Vector3d true_step =
-          (truth_prev->inverse() * *truth_curr).translation();
-      // The measured frames of this clip are off the ground truth's step by 13 mm (median,
-      // src/app/NOTES.md); the prediction was off by 28 mm on the frame this test was written
-      // on (a 68 ms step of 33 mm): a recovered step is as good as a measured one.
-      EXPECT_LT((step - true_step).norm(), 0.015) << "frame at " << frame.timestamp;
-    }
-    T_world_prev = T_world_curr;
-    prev_stamp = frame.timestamp;
+    run.estimate.push_back({frame.timestamp, Eigen::Isometry3d(result.T_world_curr)});
+    run.lost.push_back(result.lost);
+    run.recovered.push_back(result.recovered);
   }
-  EXPECT_GE(recovered, 1);
+  return run;
+}
+
+TEST(OdometryPipeline, FastRealMotionLosesNoFrame)
+{
+  // TUM fr1/desk, fast hand-held: after its 68 ms gaps, blurred frames leave neither flow fit
+  // enough static cells (2 such frames with the default seed). OpenCV's dense RGB-D odometry
+  // on the previous frame's static mask measures them instead of the constant-velocity
+  // prediction, so no frame is lost.
+  const std::string folder = dynvo::test::sharedDataPath("tum_fr1_desk_fast");
+  DYNVO_REQUIRE_SHARED_DATA(folder + "/groundtruth.txt");
+  const RecordingRun run = runFr1Recording(folder);
+  EXPECT_EQ(std::count(run.lost.begin(), run.lost.end(), true), 0);
+  EXPECT_GE(std::count(run.recovered.begin(), run.recovered.end(), true), 1);
+  // Issue 29's bar for this clip (0.036 measured with the default seed; with the two frames
+  // predicted instead, 0.040; six seeds: 0.033-0.047, src/app/NOTES.md).
+  const auto rpe = dynvo::computeRpe(dynvo::readTrajectory(folder + "/groundtruth.txt"),
+                                     run.estimate);
+  RecordProperty("rpe", std::to_string(rpe.trans_rmse));
+  EXPECT_LE(rpe.trans_rmse, 0.04);
+}
+
+TEST(OdometryPipeline, KeyframesHelpOnFastRealMotion)
+{
+  // TUM fr1/desk, fast hand-held: frame to frame, every step's error stays in the
+  // trajectory; with keyframes the pose is the mean of the chain and a fit to the keyframe,
+  // whose errors are largely independent. Mean of six seeds: 0.047 m/s without keyframes,
+  // 0.037 with them (docs/algorithm.md §7.3); the default seed: 0.052 and 0.036 (0.69 x).
+  const std::string folder = dynvo::test::sharedDataPath("tum_fr1_desk_fast");
+  DYNVO_REQUIRE_SHARED_DATA(folder + "/groundtruth.txt");
+  const dynvo::Trajectory truth = dynvo::readTrajectory(folder + "/groundtruth.txt");
+  const auto with = dynvo::computeRpe(truth, runFr1Recording(folder).estimate);
+  const auto without = dynvo::computeRpe(
+      truth, runFr1Recording(folder, [](dynvo::app::PipelineOptions& o) {
+               o.keyframes = false;
+             }).estimate);
+  RecordProperty("rpe_with_keyframes", std::to_string(with.trans_rmse));
+  RecordProperty("rpe_without_keyframes", std::to_string(without.trans_rmse));
+  ASSERT_GT(with.pairs, 50u);
+  EXPECT_LT(with.trans_rmse, 0.8 * without.trans_rmse);
 }
 
 TEST(OdometryPipeline, NoiseFollowingThresholdBoundsAreValidated)

@@ -312,7 +312,13 @@ struct OdometryPipeline::Impl {
         T_world_keyframe *
         keyframe_registration.getFinalTransformation().cast<double>();
     if (fitted && withinBound(rigidInverse(T_world_fit) * T_world_prev)) {
-      result.T_world_curr = T_world_fit;
+      // Two measurements of the pose: the frame-to-frame chain and this fit, each of ~1000
+      // LK cells under the same noise model; their mean (docs/algorithm.md §7.3).
+      result.T_world_curr = result.lost
+                                ? T_world_fit
+                                : blendPose(Eigen::Isometry3d(result.T_world_curr),
+                                            Eigen::Isometry3d(T_world_fit), 0.5)
+                                      .matrix();
       result.lost = false;
       result.lost_reason = LostReason::none;
       result.static_cells = keyframe_registration.getNumberOfInliers();
