@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <stdexcept>
 
 namespace dynvo::app {
@@ -187,11 +188,12 @@ struct OdometryPipeline::Impl {
     return {};
   }
 
-  void track(const Cloud::ConstPtr& cloud)
+  void track(const Cloud::ConstPtr& cloud, double depth_stamp)
   {
     const auto flow_start = Clock::now();
     flow_estimation.shiftCurrentToPrevious();
     flow_estimation.setInputCloud(cloud);
+    flow_estimation.setInputStamps(result.timestamp, depth_stamp);
     flow_estimation.setPredictedMotion(T_curr_prev_predicted.cast<float>());
     auto flow = pcl::make_shared<pcl::PointCloud<PointFlow>>();
     flow_estimation.compute(*flow);
@@ -312,13 +314,7 @@ struct OdometryPipeline::Impl {
         T_world_keyframe *
         keyframe_registration.getFinalTransformation().cast<double>();
     if (fitted && withinBound(rigidInverse(T_world_fit) * T_world_prev)) {
-      // Two measurements of the pose: the frame-to-frame chain and this fit, each of ~1000
-      // LK cells under the same noise model; their mean (docs/algorithm.md §7.3).
-      result.T_world_curr = result.lost
-                                ? T_world_fit
-                                : blendPose(Eigen::Isometry3d(result.T_world_curr),
-                                            Eigen::Isometry3d(T_world_fit), 0.5)
-                                      .matrix();
+      result.T_world_curr = result.lost ? T_world_fit : combineWithChain(T_world_fit);
       result.lost = false;
       result.lost_reason = LostReason::none;
       result.static_cells = keyframe_registration.getNumberOfInliers();
@@ -334,6 +330,37 @@ struct OdometryPipeline::Impl {
               : static_cast<double>(inliers) / static_cast<double>(keyframe_inliers);
     }
     result.times.registration_ms += millisecondsSince(registration_start);
+  }
+
+  /** The pose from two measurements (docs/algorithm.md §7.3): the keyframe fit and the
+   * frame-to-frame chain, whose step is fitted again on the cells the keyframe fit kept (a
+   * mover too slow to split off in one frame pair drifts out of the longer baseline's static
+   * set). Their mean, unless they depart from each other by more than 3 times the median
+   * departure of the last DEPARTURE_HISTORY frames: the keyframe fit alone then.
+   */
+  Eigen::Matrix4d combineWithChain(const Eigen::Matrix4d& T_world_fit)
+  {
+    Eigen::Matrix4d T_world_chain = result.T_world_curr;
+    registration.setStaticCells(selection.getStaticCells());
+    pcl::PointCloud<pcl::PointXYZRGB> aligned;
+    registration.align(aligned, rigidInverse(result.T_curr_prev).cast<float>());
+    if (registration.hasConverged())
+      T_world_chain =
+          T_world_prev * registration.getFinalTransformation().cast<double>();
+    const double departure =
+        (rigidInverse(T_world_chain) * T_world_fit).topRightCorner<3, 1>().norm();
+    std::vector<double> history(departures.begin(), departures.end());
+    const auto middle =
+        history.begin() + static_cast<std::ptrdiff_t>(history.size() / 2);
+    std::nth_element(history.begin(), middle, history.end());
+    const bool apart = history.size() >= MIN_DEPARTURES && departure > 3.0 * *middle;
+    departures.push_back(departure);
+    if (departures.size() > DEPARTURE_HISTORY)
+      departures.pop_front();
+    return apart ? T_world_fit
+                 : blendPose(Eigen::Isometry3d(T_world_chain),
+                             Eigen::Isometry3d(T_world_fit), 0.5)
+                       .matrix();
   }
 
   /// The backend (options.backend) from the flow estimate, on the static cells of this frame
@@ -362,13 +389,18 @@ struct OdometryPipeline::Impl {
    */
   void recoverDense(const Cloud::ConstPtr& cloud)
   {
-    if (previous_static_cells.size() == 0)
-      return;
     const auto start = Clock::now();
+    // No frame measured yet: the start-up assumption, every cell static (docs §4).
+    FlowGrid mask = previous_static_cells;
+    if (mask.size() == 0) {
+      mask = FlowGrid(cloud->width, cloud->height,
+                      static_cast<std::uint32_t>(options.scene_flow.cell_size));
+      std::fill(mask.labels.begin(), mask.labels.end(), LABEL_STATIC);
+    }
     recovery.setInputSource(cloud);
     recovery.setInputTarget(previous);
-    recovery.setSourceStaticCells(previous_static_cells);
-    recovery.setTargetStaticCells(previous_static_cells);
+    recovery.setSourceStaticCells(mask);
+    recovery.setTargetStaticCells(mask);
     Eigen::Matrix4f T_prev_curr;
     if (recovery.align(rigidInverse(T_curr_prev_predicted).cast<float>(),
                        T_prev_curr)) {
@@ -402,6 +434,10 @@ struct OdometryPipeline::Impl {
   std::size_t keyframe_inliers =
       0; ///< inliers of the first fit to the keyframe (0: none yet)
   std::size_t keyframe_frame = 0; ///< frame number of the keyframe
+  /// frames whose departure between chain and keyframe fit sets the scale of the next
+  static constexpr std::size_t DEPARTURE_HISTORY = 30;
+  static constexpr std::size_t MIN_DEPARTURES = 5; ///< fewer: the mean, unconditionally
+  std::deque<double> departures; ///< the last departures (metres), oldest first
   StaticSetSelection<pcl::PointXYZRGB> selection;
   InlierNoiseTracker noise_tracker;
   StaticMaskRegistration<pcl::PointXYZRGB> backend;
@@ -462,6 +498,7 @@ OdometryPipeline::process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& clo
   const double depth_stamp = std::isnan(depth_timestamp) ? timestamp : depth_timestamp;
   if (p.frames == 0) {
     p.flow_estimation.setInputCloud(cloud);
+    p.flow_estimation.setInputStamps(timestamp, depth_stamp);
     // No motion to segment yet: under the start-up assumption (docs/algorithm.md §4, §6.1)
     // every pixel with depth is static background.
     result.segments.assign(1, pcl::PointIndices());
@@ -491,7 +528,7 @@ OdometryPipeline::process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& clo
         share < 1.0 ? scaleStep(velocity_step, share) : velocity_step;
     if (std::isfinite(colour_dt) && colour_dt > 0.0)
       p.last_colour_dt = colour_dt;
-    p.track(cloud);
+    p.track(cloud, depth_stamp);
     result.T_world_curr = p.T_world_prev * rigidInverse(result.T_curr_prev);
     // The keyframe fit is the flow backend's; the other backends run frame to frame.
     if (p.options.keyframes && p.options.backend.backend == RegistrationBackend::flow) {

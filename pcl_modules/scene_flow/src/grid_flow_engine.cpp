@@ -129,6 +129,30 @@ windowDepth(const std::vector<float>& depth,
                                           : z_point;
 }
 
+/// Depth at the sub-pixel q (inside [1, width-2] x [1, height-2]): trackedDepth(), then the
+/// window's plane when depth_window_radius r > 0; NaN without depth.
+float
+depthAt(const std::vector<float>& depth,
+        int width,
+        int height,
+        cv::Point2f q,
+        int r,
+        const GridSceneFlowParameters& params)
+{
+  const float z = trackedDepth(depth, width, q, params.depth_edge_tolerance);
+  if (std::isnan(z) || r == 0)
+    return z;
+  return windowDepth(depth, width, height, q, z, r, params.depth_edge_tolerance);
+}
+
+/// The depth image's stamp minus the colour image's (seconds), 0 when either is unknown.
+float
+depthOffset(const GridFlowEngine::FrameStamps& stamps)
+{
+  const double offset = stamps.depth - stamps.colour;
+  return std::isfinite(offset) ? static_cast<float>(offset) : 0.0f;
+}
+
 } // namespace
 
 struct GridFlowEngine::Frame {
@@ -138,6 +162,9 @@ struct GridFlowEngine::Frame {
       pyramid;              ///< cv::buildOpticalFlowPyramid output, with derivatives
   std::vector<float> depth; ///< preprocessed (metres, NaN = invalid)
   DepthPreprocessing preprocessing;
+  FrameStamps stamps;
+  /// per cell, its image velocity (px/s) from this frame's frame-to-frame track; empty: none
+  std::vector<Eigen::Vector2f> velocity;
 };
 
 GridFlowEngine::GridFlowEngine()
@@ -155,7 +182,8 @@ GridFlowEngine::prepare(Slot slot,
                         std::uint32_t width,
                         std::uint32_t height,
                         const GridSceneFlowParameters& params,
-                        unsigned threads)
+                        unsigned threads,
+                        const FrameStamps& stamps)
 {
   std::shared_ptr<Frame>& stored = slot == Slot::current ? current_ : previous_;
   if (stored == keyframe_)
@@ -163,6 +191,8 @@ GridFlowEngine::prepare(Slot slot,
   Frame& frame = *stored;
   frame.width = width;
   frame.height = height;
+  frame.stamps = stamps;
+  frame.velocity.clear();
   frame.preprocessing.setParameters(params.depth);
   frame.preprocessing.setNumberOfThreads(threads);
   frame.preprocessing.apply(depth, width, height, frame.depth);
@@ -205,10 +235,12 @@ GridFlowEngine::compute(const GridSceneFlowParameters& params,
                         const CameraIntrinsics& intrinsics,
                         unsigned threads,
                         const Eigen::Matrix4f& T_previous_current,
-                        pcl::PointCloud<PointFlow>& flow) const
+                        pcl::PointCloud<PointFlow>& flow)
 {
+  std::vector<Eigen::Vector2f> velocity;
   track(*previous_, params, intrinsics, threads, T_previous_current, {},
-        params.max_pyramid_level, true, flow);
+        params.max_pyramid_level, true, flow, velocity);
+  current_->velocity = std::move(velocity);
 }
 
 void
@@ -223,8 +255,9 @@ GridFlowEngine::computeToKeyframe(const GridSceneFlowParameters& params,
   if (!keyframe_)
     throw std::logic_error(
         "[dynvo::detail::GridFlowEngine::computeToKeyframe] no keyframe kept");
+  std::vector<Eigen::Vector2f> velocity;
   track(*keyframe_, params, intrinsics, threads, T_keyframe_current, selected,
-        std::clamp(max_level, 0, params.max_pyramid_level), false, flow);
+        std::clamp(max_level, 0, params.max_pyramid_level), false, flow, velocity);
 }
 
 void
@@ -235,8 +268,9 @@ GridFlowEngine::track(const Frame& reference,
                       const Eigen::Matrix4f& T_reference_current,
                       const std::vector<std::uint8_t>& selected,
                       int max_level,
-                      bool identity_within_reach,
-                      pcl::PointCloud<PointFlow>& flow) const
+                      bool frame_to_frame,
+                      pcl::PointCloud<PointFlow>& flow,
+                      std::vector<Eigen::Vector2f>& velocity) const
 {
   const Frame& curr = *current_;
   const Frame& prev = reference;
@@ -293,7 +327,7 @@ GridFlowEngine::track(const Frame& reference,
   // Frame to frame, a prediction within the pyramid's reach of the cells (half a window on
   // the top level: (window / 2) * 2^max_level px, median over the cells) is not needed, and
   // the search starts at every cell itself.
-  if (identity_within_reach && !seeds.empty()) {
+  if (frame_to_frame && !seeds.empty()) {
     std::vector<float> shift(seeds.size());
     for (std::size_t k = 0; k < seeds.size(); ++k)
       shift[k] = static_cast<float>(cv::norm(seeds[k] - centres[tracked_cells[k]]));
@@ -366,6 +400,43 @@ GridFlowEngine::track(const Frame& reference,
     }
   });
 
+  // Each cell's image velocity (px/s): frame to frame, that of this track; to the keyframe,
+  // the one the current frame kept from its own frame-to-frame track (none: zero).
+  velocity.assign(n, Eigen::Vector2f::Zero());
+  if (frame_to_frame) {
+    const double dt = curr.stamps.colour - prev.stamps.colour;
+    if (dt > 0.0) // false when a stamp is unknown
+      for (std::size_t i = 0; i < n; ++i)
+        if (valid2d[i])
+          velocity[i] = Eigen::Vector2f(centres[i].x - tracked[i].x,
+                                        centres[i].y - tracked[i].y) /
+                        static_cast<float>(dt);
+  }
+  else if (curr.velocity.size() == n) {
+    velocity = curr.velocity;
+  }
+  // The point a_i of the reference: frame to frame, the cell's own velocity; in the keyframe,
+  // the keyframe's velocity of the cell p_i falls in.
+  const auto reference_velocity = [&](std::size_t i, cv::Point2f p) {
+    if (frame_to_frame)
+      return velocity[i];
+    if (prev.velocity.size() != n)
+      return Eigen::Vector2f(Eigen::Vector2f::Zero());
+    const int c = std::clamp(static_cast<int>(p.x) / cell, 0, cols - 1);
+    const int row = std::clamp(static_cast<int>(p.y) / cell, 0, rows - 1);
+    return prev.velocity[static_cast<std::size_t>(row) * cols + c];
+  };
+  const float offset_curr = depthOffset(curr.stamps);
+  const float offset_prev = depthOffset(prev.stamps);
+  // Where the depth image saw the point seen at q in the colour image: q moved along the
+  // image velocity v by the frame's depth-minus-colour offset.
+  const auto atDepthInstant = [](cv::Point2f q, const Eigen::Vector2f& v, float offset) {
+    return cv::Point2f(q.x + v.x() * offset, q.y + v.y() * offset);
+  };
+  const auto inside = [width, height](cv::Point2f q) {
+    return q.x >= 1.0f && q.y >= 1.0f && q.x <= width - 2.0f && q.y <= height - 2.0f;
+  };
+
   flow.resize(static_cast<std::uint32_t>(cols), static_cast<std::uint32_t>(rows));
   flow.is_dense = false;
   const float max_flow2 = params.max_flow * params.max_flow;
@@ -386,20 +457,30 @@ GridFlowEngine::track(const Frame& reference,
     f.valid_3d = 0;
     if (!f.valid_2d || std::isnan(z_b))
       continue;
-    float z_a = trackedDepth(prev.depth, width, p, params.depth_edge_tolerance);
+    // Both ends at their depth instants (docs/algorithm.md §1.2); no offset: where tracked.
+    const cv::Point2f c_d = atDepthInstant(c, velocity[i], offset_curr);
+    const cv::Point2f p_d = atDepthInstant(p, reference_velocity(i, p), offset_prev);
+    if (c_d != c) {
+      if (!inside(c_d))
+        continue;
+      const float z = depthAt(curr.depth, width, height, c_d, r, params);
+      if (std::isnan(z))
+        continue;
+      f.getVector3fMap() = intrinsics.backproject(c_d.x, c_d.y, z);
+    }
+    if (!inside(p_d))
+      continue;
+    const float z_a = depthAt(prev.depth, width, height, p_d, r, params);
     if (std::isnan(z_a))
       continue;
-    if (r > 0)
-      z_a = windowDepth(prev.depth, width, height, p, z_a, r,
-                        params.depth_edge_tolerance);
-    const Eigen::Vector3f a = intrinsics.backproject(p.x, p.y, z_a);
+    const Eigen::Vector3f a = intrinsics.backproject(p_d.x, p_d.y, z_a);
     if ((f.getVector3fMap() - a).squaredNorm() > max_flow2)
       continue;
     f.prev_x = a.x();
     f.prev_y = a.y();
     f.prev_z = a.z();
     f.valid_3d = 1;
-    const float ratio = params.weight_reference_depth / std::max(z_a, z_b);
+    const float ratio = params.weight_reference_depth / std::max(z_a, f.z);
     f.weight = std::min(1.0f, ratio * ratio * ratio * ratio);
   }
 }

@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -24,6 +25,12 @@ namespace dynvo::detail {
  */
 class DYNVO_EXPORTS GridFlowEngine {
 public:
+  /// When a frame's colour and depth images were taken (seconds; NaN: unknown, no offset).
+  struct FrameStamps {
+    double colour = std::numeric_limits<double>::quiet_NaN();
+    double depth = std::numeric_limits<double>::quiet_NaN();
+  };
+
   /// Which of the two stored frames an operation addresses.
   enum class Slot { current, previous };
 
@@ -39,6 +46,7 @@ public:
    * \param[in] height rows (px)
    * \param[in] params validated parameters (depth rules, LK window and levels)
    * \param[in] threads worker threads (>= 1)
+   * \param[in] stamps when the colour and the depth image were taken (seconds; NaN: unknown)
    */
   void prepare(Slot slot,
                const std::vector<std::uint8_t>& grey,
@@ -46,7 +54,8 @@ public:
                std::uint32_t width,
                std::uint32_t height,
                const GridSceneFlowParameters& params,
-               unsigned threads);
+               unsigned threads,
+               const FrameStamps& stamps);
 
   /// The current slot becomes the previous one (no copy); the current slot is then stale.
   void shiftCurrentToPrevious();
@@ -67,14 +76,15 @@ public:
    * px, median over the cells), every cell starts at its predicted position in the previous
    * frame, the projection of T_previous_current * b_i (a cell without depth: of its ray, as a
    * point at infinity); otherwise every cell starts where it is. The whole pyramid is
-   * searched.
+   * searched. The current slot keeps each cell's image velocity (px/s) for the depth
+   * instants of later fits (docs/algorithm.md §1.2).
    * \param[out] flow organized (width / cell_size) x (height / cell_size) cloud
    */
   void compute(const GridSceneFlowParameters& params,
                const CameraIntrinsics& intrinsics,
                unsigned threads,
                const Eigen::Matrix4f& T_previous_current,
-               pcl::PointCloud<PointFlow>& flow) const;
+               pcl::PointCloud<PointFlow>& flow);
 
   /** \brief Grid scene flow from the keyframe to the current slot, seeded (docs/algorithm.md
    * §7.3): each selected cell with depth b_i starts at the projection of
@@ -98,11 +108,13 @@ public:
 private:
   struct Frame;
 
-  /// Tracks the selected cells of the current slot into reference, each from its
-  /// predicted position under T_reference_current (from the cell itself instead when
-  /// identity_within_reach and the prediction moves the cells by no more than the pyramid
-  /// reaches, median over the cells), and back-projects both ends: compute() and
-  /// computeToKeyframe().
+  /** Tracks the selected cells of the current slot into reference, each from its
+   * predicted position under T_reference_current, and back-projects both ends at their
+   * frames' depth instants: compute() (frame_to_frame: a cell starts from itself when the
+   * prediction moves the cells by no more than the pyramid reaches, median over the cells;
+   * the cell's image velocity is that of this track, returned in velocity) and
+   * computeToKeyframe() (the velocities kept by each frame's compute()).
+   */
   void track(const Frame& reference,
              const GridSceneFlowParameters& params,
              const CameraIntrinsics& intrinsics,
@@ -110,8 +122,9 @@ private:
              const Eigen::Matrix4f& T_reference_current,
              const std::vector<std::uint8_t>& selected,
              int max_level,
-             bool identity_within_reach,
-             pcl::PointCloud<PointFlow>& flow) const;
+             bool frame_to_frame,
+             pcl::PointCloud<PointFlow>& flow,
+             std::vector<Eigen::Vector2f>& velocity) const;
 
   std::shared_ptr<Frame> current_;
   std::shared_ptr<Frame> previous_;

@@ -70,7 +70,20 @@ public:
   const std::string& getClassName() const { return class_name_; }
 
   /// Current frame k (organized, metres, current camera frame); the grid is anchored here.
+  /// Its stamps are unknown until setInputStamps().
   void setInputCloud(const PointCloudConstPtr& cloud) override;
+
+  /** \brief When the input cloud's colour and depth images were taken (seconds; call after
+   * setInputCloud(), before compute()). A sensor whose two streams are not synchronised (TUM fr1: up to 17 ms
+   * apart) sees a moving point in the depth image where it was at the depth instant: each
+   * flow end is then read and back-projected there, moved along the cell's image velocity,
+   * so that a_i and b_i are the points at the two frames' depth instants
+   * (docs/algorithm.md §1.2). Unknown stamps (NaN, the default) or equal ones: no shift.
+   */
+  void setInputStamps(double colour_stamp, double depth_stamp)
+  {
+    input_stamps_ = {colour_stamp, depth_stamp};
+  }
 
   /// Previous frame k-1 (organized, same size as the input cloud).
   void setPreviousCloud(const PointCloudConstPtr& cloud);
@@ -176,7 +189,9 @@ protected:
   bool validateInputs() const;
 
   /// Converts a cloud to grey levels and depths and prepares it in an engine slot.
-  void prepareFrame(const PointCloud& cloud, detail::GridFlowEngine::Slot slot);
+  void prepareFrame(const PointCloud& cloud,
+                    detail::GridFlowEngine::Slot slot,
+                    const detail::GridFlowEngine::FrameStamps& stamps);
 
 private:
   /// Stores checked parameters and drops the prepared frames (they depend on them).
@@ -189,6 +204,8 @@ private:
   PointCloudConstPtr previous_;   ///< frame k-1
   PointCloudConstPtr keyframe_;   ///< the kept keyframe, or null
   detail::GridFlowEngine engine_; ///< pyramids and preprocessed depth of both frames
+  detail::GridFlowEngine::FrameStamps input_stamps_;    ///< of the input cloud
+  detail::GridFlowEngine::FrameStamps previous_stamps_; ///< of the previous cloud
   bool current_ready_ = false;    ///< engine current slot matches input_ and params_
   bool previous_ready_ = false; ///< engine previous slot matches previous_ and params_
   std::vector<std::uint8_t> grey_;     ///< conversion buffer (grey levels)

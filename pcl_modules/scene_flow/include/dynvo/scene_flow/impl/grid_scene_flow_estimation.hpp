@@ -22,6 +22,7 @@ GridSceneFlowEstimation<PointT>::setInputCloud(const PointCloudConstPtr& cloud)
 {
   Base::setInputCloud(cloud);
   current_ready_ = false;
+  input_stamps_ = {};
 }
 
 template <typename PointT>
@@ -30,6 +31,7 @@ GridSceneFlowEstimation<PointT>::setPreviousCloud(const PointCloudConstPtr& clou
 {
   previous_ = cloud;
   previous_ready_ = false;
+  previous_stamps_ = {};
 }
 
 template <typename PointT>
@@ -39,8 +41,10 @@ GridSceneFlowEstimation<PointT>::shiftCurrentToPrevious()
   engine_.shiftCurrentToPrevious();
   previous_ = input_;
   previous_ready_ = current_ready_;
+  previous_stamps_ = input_stamps_;
   input_.reset();
   current_ready_ = false;
+  input_stamps_ = {};
 }
 
 template <typename PointT>
@@ -129,8 +133,10 @@ GridSceneFlowEstimation<PointT>::validateInputs() const
 
 template <typename PointT>
 void
-GridSceneFlowEstimation<PointT>::prepareFrame(const PointCloud& cloud,
-                                              detail::GridFlowEngine::Slot slot)
+GridSceneFlowEstimation<PointT>::prepareFrame(
+    const PointCloud& cloud,
+    detail::GridFlowEngine::Slot slot,
+    const detail::GridFlowEngine::FrameStamps& stamps)
 {
   const std::size_t size = cloud.size();
   grey_.resize(size);
@@ -140,7 +146,8 @@ GridSceneFlowEstimation<PointT>::prepareFrame(const PointCloud& cloud,
     grey_[i] = luma(p.r, p.g, p.b);
     depth_[i] = std::isfinite(p.z) ? p.z : std::numeric_limits<float>::quiet_NaN();
   }
-  engine_.prepare(slot, grey_, depth_, cloud.width, cloud.height, params_, threads_);
+  engine_.prepare(slot, grey_, depth_, cloud.width, cloud.height, params_, threads_,
+                  stamps);
 }
 
 template <typename PointT>
@@ -158,10 +165,10 @@ GridSceneFlowEstimation<PointT>::compute(FlowCloud& flow)
   if (!validateInputs())
     return;
   if (!current_ready_)
-    prepareFrame(*input_, detail::GridFlowEngine::Slot::current);
+    prepareFrame(*input_, detail::GridFlowEngine::Slot::current, input_stamps_);
   current_ready_ = true;
   if (!previous_ready_)
-    prepareFrame(*previous_, detail::GridFlowEngine::Slot::previous);
+    prepareFrame(*previous_, detail::GridFlowEngine::Slot::previous, previous_stamps_);
   previous_ready_ = true;
   engine_.compute(params_, intrinsics_, threads_,
                   rigidInverse(predicted_motion_.cast<double>()).cast<float>(), flow);
