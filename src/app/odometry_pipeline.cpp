@@ -140,6 +140,7 @@ PipelineOptions::validate() const
   backend.validate();
   static_set.validate();
   inlier_noise.validate();
+  motion_evidence.validate();
   table().checkAll(*this, "[dynvo::app::PipelineOptions]");
   if (!(inlier_noise.min_inlier_threshold <= segmentation.inlier_threshold))
     throw std::invalid_argument(
@@ -165,6 +166,8 @@ struct OdometryPipeline::Impl {
     registration.setSensorNoise(options.segmentation.noise, focal);
     keyframe_registration.setSensorNoise(options.segmentation.noise, focal);
     selection.setParameters(options.static_set);
+    evidence.setParameters(options.motion_evidence);
+    evidence.setSensorNoise(options.segmentation.noise, focal);
     noise_tracker.setParameters(options.inlier_noise);
     noise_tracker.setUpperBound(options.segmentation.inlier_threshold);
     backend.setParameters(options.backend);
@@ -198,6 +201,7 @@ struct OdometryPipeline::Impl {
     auto flow = pcl::make_shared<pcl::PointCloud<PointFlow>>();
     flow_estimation.compute(*flow);
     result.times.scene_flow_ms = millisecondsSince(flow_start);
+    frame_flow = flow;
 
     const auto segmentation_start = Clock::now();
     // The ego-motion guard's tolerance grows with the predicted motion (docs/algorithm.md
@@ -217,6 +221,8 @@ struct OdometryPipeline::Impl {
       result.motions = segmentation.getMotions();
       selection.setCellLabels(segmentation.getCellGrid());
       selection.setInlierThreshold(result.inlier_threshold);
+      evidence.predict(*flow, cloud->width, cloud->height);
+      selection.setMovingCells(evidence.getMovingCells());
     }
     else {
       selection.clearCellLabels();
@@ -439,6 +445,9 @@ struct OdometryPipeline::Impl {
   static constexpr std::size_t MIN_DEPARTURES = 5; ///< fewer: the mean, unconditionally
   std::deque<double> departures; ///< the last departures (metres), oldest first
   StaticSetSelection<pcl::PointXYZRGB> selection;
+  MotionEvidence evidence; ///< cells left out of the fits (with segmentation)
+  pcl::PointCloud<PointFlow>::ConstPtr
+      frame_flow; ///< this frame's flow to the previous
   InlierNoiseTracker noise_tracker;
   StaticMaskRegistration<pcl::PointXYZRGB> backend;
   StaticMaskRegistration<pcl::PointXYZRGB>
@@ -542,6 +551,8 @@ OdometryPipeline::process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& clo
     // lost frames until it diverges (docs/algorithm.md §7.5).
     orthonormalize(result.T_world_curr);
     p.last_step = result.T_curr_prev;
+    if (p.options.use_segmentation && !result.lost)
+      p.evidence.update(*p.frame_flow, rigidInverse(result.T_curr_prev));
   }
   result.labels = paintLabelImage(result.segments, result.segment_labels, result.width,
                                   result.height)

@@ -102,6 +102,8 @@ pipelineConfigTable()
                  StaticSetSelectionParameters::table().fields()),
       nestFields("pipeline", &P::inlier_noise,
                  InlierNoiseTrackerParameters::table().fields()),
+      nestFields("pipeline", &P::motion_evidence,
+                 MotionEvidenceParameters::table().fields()),
       prefixFields("pipeline",
                    {own.field("threads"), own.field("keyframes"),
                     own.field("keyframe_min_overlap"),

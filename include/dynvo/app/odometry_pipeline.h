@@ -7,6 +7,7 @@
 #include <dynvo/common/parameter_table.h>
 #include <dynvo/motion_segmentation/rigid_motion_segmentation_parameters.h>
 #include <dynvo/registration/inlier_noise_tracker.h>
+#include <dynvo/registration/motion_evidence.h>
 #include <dynvo/registration/static_mask_registration_parameters.h>
 #include <dynvo/registration/static_scene_registration_parameters.h>
 #include <dynvo/registration/static_set_selection_parameters.h>
@@ -52,6 +53,9 @@ struct DYNVO_EXPORTS PipelineOptions {
   /// Noise-following inlier threshold (InlierNoiseTracker; YAML pipeline.inlier_noise_factor
   /// and pipeline.min_inlier_threshold), bounded above by segmentation.inlier_threshold.
   InlierNoiseTrackerParameters inlier_noise;
+  /// Per-cell evidence of motion over frames (MotionEvidence; YAML pipeline.evidence_*):
+  /// cells above its limit are left out of every fit. Only with segmentation.
+  MotionEvidenceParameters motion_evidence;
   unsigned threads = 1; ///< worker threads; results do not depend on it
   /// Keyframe registration (docs/algorithm.md §7.3): the static cells of each frame are also
   /// registered against the current keyframe, which gives the pose; false: frame to frame.

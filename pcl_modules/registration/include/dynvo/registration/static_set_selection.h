@@ -30,6 +30,8 @@ namespace dynvo {
  *    m^2), leaving out the cells labelled as objects (label > LABEL_STATIC) when the labels
  *    are trusted. Background cells the segmentation split off count again; moving objects
  *    stay out.
+ * The moving cells of setMovingCells() (MotionEvidence's, docs/algorithm.md §7.6) are left
+ * out of every step whatever their label.
  * Steps 2 and 3 run only when static_consensus > 0. Without labels (clearCellLabels(), the
  * default) every valid flow cell is static and only step 1 runs (the pipeline's ablation
  * without segmentation). Labels whose grid is not the flow's (e.g. the empty grid of a failed
@@ -88,6 +90,12 @@ public:
     use_labels_ = false;
   }
 
+  /** \brief Cells left out of every fit whatever their label (MotionEvidence's moving cells:
+   * labels other than LABEL_NONE); an empty grid, or one that is not the flow's, leaves none
+   * out (the default).
+   */
+  void setMovingCells(const FlowGrid& moving) { moving_ = moving; }
+
   /// Segmentation inlier threshold in use this frame (m^2, default 3e-5).
   void setInlierThreshold(double threshold) { inlier_threshold_ = threshold; }
 
@@ -134,10 +142,19 @@ private:
                        bool exclude_objects,
                        double limit);
 
+  /// Cell i (of static_cells_' grid) is among the moving cells of setMovingCells().
+  bool leftOut(std::size_t i) const
+  {
+    return moving_.sameGeometry(static_cells_) &&
+           moving_.labels.size() == static_cells_.labels.size() &&
+           moving_.labels[i] != LABEL_NONE;
+  }
+
   std::string class_name_ = "StaticSetSelection"; ///< log prefix
   Parameters params_;                             ///< validated knobs
   FlowGrid labels_;                               ///< segmentation's cell labels
   bool use_labels_ = false;                       ///< false: every valid cell is static
+  FlowGrid moving_;                               ///< cells left out of every fit
   double inlier_threshold_ = 3e-5;                ///< m^2
   double guard_tolerance_ = 0.03;                 ///< tau_cv (metres)
   Eigen::Matrix4d T_curr_prev_predicted_ = Eigen::Matrix4d::Identity(); ///< H_pred

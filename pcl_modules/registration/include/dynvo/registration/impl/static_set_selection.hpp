@@ -39,6 +39,7 @@ StaticSetSelection<PointT>::selectConsensus(const FlowCloud& flow,
     const PointFlow& cell = flow[i];
     const bool selected =
         cell.valid_3d && !(exclude_objects && labels_.labels[i] > LABEL_STATIC) &&
+        !leftOut(i) &&
         squaredTransferError(T_prev_curr, cell.getVector3fMap().cast<double>(),
                              Eigen::Vector3d(cell.prev_x, cell.prev_y, cell.prev_z)) <=
             limit;
@@ -61,14 +62,15 @@ StaticSetSelection<PointT>::align(Registration& registration)
   }
   if (!use_labels_) {
     for (std::size_t i = 0; i < flow->size(); ++i)
-      static_cells_.labels[i] = (*flow)[i].valid_3d ? LABEL_STATIC : LABEL_NONE;
+      static_cells_.labels[i] =
+          (*flow)[i].valid_3d && !leftOut(i) ? LABEL_STATIC : LABEL_NONE;
     return fit(registration, rigidInverse(T_curr_prev_predicted_), true);
   }
   const bool labels_fit = labels_.sameGeometry(static_cells_) &&
                           labels_.labels.size() == static_cells_.size();
   for (std::size_t i = 0; labels_fit && i < static_cells_.size(); ++i)
     static_cells_.labels[i] =
-        labels_.labels[i] == LABEL_STATIC ? LABEL_STATIC : LABEL_NONE;
+        labels_.labels[i] == LABEL_STATIC && !leftOut(i) ? LABEL_STATIC : LABEL_NONE;
 
   const Eigen::Matrix4d T_prev_curr_predicted = rigidInverse(T_curr_prev_predicted_);
   const bool background_fit =
