@@ -164,6 +164,43 @@ TEST_F(Selection, MotionGuardOverridesABackgroundLabelOnTheMovingBox)
   EXPECT_GT(translationError(registration_.getFinalTransformation(), truth()), 0.03);
 }
 
+TEST_F(Selection, MovingCellsAreLeftOutOfEveryFitWhateverTheirLabel)
+{
+  // The segmentation merged the moving box into the background (every valid cell labelled
+  // static). Its first fit leans to the box and the guard distrusts the labels; with the box's
+  // cells given as moving (MotionEvidence's, docs/algorithm.md §7.6) no fit uses them, the
+  // first fit agrees with H_pred and the static set is exactly the background.
+  FlowGrid merged = trueLabels();
+  FlowGrid moving = pair_.grid;
+  for (std::size_t i = 0; i < merged.size(); ++i) {
+    moving.labels[i] = merged.labels[i] == LABEL_OBJECT ? LABEL_OBJECT : LABEL_NONE;
+    if (merged.labels[i] == LABEL_OBJECT)
+      merged.labels[i] = LABEL_STATIC;
+  }
+  selection_.setCellLabels(merged);
+  ASSERT_TRUE(selection_.align(registration_));
+  EXPECT_FALSE(selection_.getLabelsTrusted());
+
+  selection_.setMovingCells(moving);
+  ASSERT_TRUE(selection_.align(registration_));
+  EXPECT_TRUE(selection_.getLabelsTrusted());
+  expectTruth();
+  const FlowGrid& selected = selection_.getStaticCells();
+  for (std::size_t i = 0; i < selected.size(); ++i)
+    EXPECT_EQ(selected.labels[i] == LABEL_STATIC, pair_.static_cells[i] == 1)
+        << "cell " << i;
+
+  // Without labels too (every other valid cell is static).
+  selection_.clearCellLabels();
+  ASSERT_TRUE(selection_.align(registration_));
+  EXPECT_EQ(count(selection_.getStaticCells(), LABEL_STATIC), pair_.staticCellCount());
+
+  // A grid that is not the flow's leaves no cell out.
+  selection_.setMovingCells(FlowGrid(320, 240, 16));
+  ASSERT_TRUE(selection_.align(registration_));
+  EXPECT_GT(count(selection_.getStaticCells(), LABEL_STATIC), pair_.staticCellCount());
+}
+
 TEST_F(Selection, IntermediateFitsLeaveTheRefinementSettingAsItWas)
 {
   // The first fit and the guard's fit choose cells with the metric fit; the registration's
