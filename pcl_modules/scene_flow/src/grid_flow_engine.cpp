@@ -163,6 +163,8 @@ struct GridFlowEngine::Frame {
   std::vector<float> depth; ///< preprocessed (metres, NaN = invalid)
   DepthPreprocessing preprocessing;
   FrameStamps stamps;
+  /// per cell, the depth b_i is read at c_i (NaN: none), for every track of this frame
+  std::vector<float> centre_depth;
   /// per cell, its image velocity (px/s) from this frame's frame-to-frame track; empty: none
   std::vector<Eigen::Vector2f> velocity;
 };
@@ -196,6 +198,23 @@ GridFlowEngine::prepare(Slot slot,
   frame.preprocessing.setParameters(params.depth);
   frame.preprocessing.setNumberOfThreads(threads);
   frame.preprocessing.apply(depth, width, height, frame.depth);
+  // b_i's depth at each cell centre c_i: the same for the frame-to-frame and keyframe tracks.
+  const int cell = params.cell_size;
+  const int cols = static_cast<int>(width) / cell,
+            rows = static_cast<int>(height) / cell;
+  const int r = params.depth_window_radius;
+  frame.centre_depth.resize(static_cast<std::size_t>(cols) * rows);
+  for (int row = 0; row < rows; ++row)
+    for (int c = 0; c < cols; ++c) {
+      const int u = c * cell + cell / 2, v = row * cell + cell / 2;
+      float z = centreDepth(frame.depth, static_cast<int>(width),
+                            static_cast<int>(height), u, v);
+      if (r > 0 && !std::isnan(z))
+        z = windowDepth(frame.depth, static_cast<int>(width), static_cast<int>(height),
+                        cv::Point2f(static_cast<float>(u), static_cast<float>(v)), z, r,
+                        params.depth_edge_tolerance);
+      frame.centre_depth[static_cast<std::size_t>(row) * cols + c] = z;
+    }
   // The grey buffer is only read: buildOpticalFlowPyramid copies level 0 into a padded image.
   const cv::Mat image(static_cast<int>(height), static_cast<int>(width), CV_8UC1,
                       const_cast<std::uint8_t*>(grey.data()));
@@ -282,21 +301,18 @@ GridFlowEngine::track(const Frame& reference,
   const std::size_t n = static_cast<std::size_t>(cols) * rows;
   const int r = params.depth_window_radius;
 
-  // c_i and the depth b_i is read at (NaN: none).
+  // c_i, and the depth b_i is read at (NaN: none; prepare()).
   std::vector<cv::Point2f> centres(n);
-  std::vector<float> centre_depth(n);
   for (int row = 0; row < rows; ++row)
-    for (int c = 0; c < cols; ++c) {
-      const std::size_t i = static_cast<std::size_t>(row) * cols + c;
-      centres[i] = cv::Point2f(static_cast<float>(c * cell + cell / 2),
-                               static_cast<float>(row * cell + cell / 2));
-      float z_b = centreDepth(curr.depth, width, height, c * cell + cell / 2,
-                              row * cell + cell / 2);
-      if (r > 0 && !std::isnan(z_b))
-        z_b = windowDepth(curr.depth, width, height, centres[i], z_b, r,
-                          params.depth_edge_tolerance);
-      centre_depth[i] = z_b;
-    }
+    for (int c = 0; c < cols; ++c)
+      centres[static_cast<std::size_t>(row) * cols + c] =
+          cv::Point2f(static_cast<float>(c * cell + cell / 2),
+                      static_cast<float>(row * cell + cell / 2));
+  const std::vector<float>& centre_depth = curr.centre_depth;
+  // Inside [1, W-2] x [1, H-2]: the 2x2 bilinear depth footprint stays in the image.
+  const auto inside = [width, height](cv::Point2f q) {
+    return q.x >= 1.0f && q.y >= 1.0f && q.x <= width - 2.0f && q.y <= height - 2.0f;
+  };
 
   // Cells to track, and where each starts in the reference frame: the projection of
   // T_reference_current * b_i, or of the cell's ray rotated alone (a point at infinity) when
@@ -372,9 +388,7 @@ GridFlowEngine::track(const Frame& reference,
       const std::size_t i = tracked_cells[begin + k];
       tracked[i] = to[k];
       const cv::Point2f& p = to[k];
-      // p_i inside [1, W-2] x [1, H-2]: the 2x2 bilinear depth footprint stays in the image.
-      if (status[k] && p.x >= 1.0f && p.y >= 1.0f && p.x <= width - 2.0f &&
-          p.y <= height - 2.0f) {
+      if (status[k] && inside(p)) {
         forward.push_back(p);
         index.push_back(i);
       }
@@ -430,13 +444,10 @@ GridFlowEngine::track(const Frame& reference,
   const float offset_prev = depthOffset(prev.stamps);
   // Where the depth image saw the point seen at q in the colour image: q moved along the
   // image velocity v by the frame's depth-minus-colour offset.
-  const auto atDepthInstant = [](cv::Point2f q, const Eigen::Vector2f& v, float offset) {
+  const auto atDepthInstant = [](cv::Point2f q, const Eigen::Vector2f& v,
+                                 float offset) {
     return cv::Point2f(q.x + v.x() * offset, q.y + v.y() * offset);
   };
-  const auto inside = [width, height](cv::Point2f q) {
-    return q.x >= 1.0f && q.y >= 1.0f && q.x <= width - 2.0f && q.y <= height - 2.0f;
-  };
-
   flow.resize(static_cast<std::uint32_t>(cols), static_cast<std::uint32_t>(rows));
   flow.is_dense = false;
   const float max_flow2 = params.max_flow * params.max_flow;
