@@ -681,26 +681,57 @@ TEST(OdometryPipeline, FramesNoFlowFitMeasuresAreRecoveredByTheDenseFit)
 TEST(OdometryPipeline, FastRealMotionIsTrackedAndKeyframesHelp)
 {
   // TUM fr1/desk, fast hand-held (0.5-0.9 m/s, 68 ms gaps, blur). Issue 29's bar: no frame
-  // lost and RPE <= 0.04 m/s (the default seed: 0.034; six seeds 0.034-0.043). Frame to
-  // frame, every step's error stays in the trajectory; with keyframes the pose combines the
-  // chain with a fit to the keyframe, whose errors are largely independent (docs/algorithm.md
-  // §7.3). Six seeds: 0.047 without keyframes, 0.038 with them (0.80 x); the default seed
-  // 0.045 and 0.034 (0.76 x).
+  // lost and RPE <= 0.04 m/s. The RPE of one seed (the segmentation's hypothesis sampling)
+  // spreads over 0.031-0.043 on this clip, across the bar, so the bar is held by the mean of
+  // six seeds (0.0376 measured), the expected error, not by one draw. Frame to frame, every
+  // step's error stays in the trajectory; with keyframes the pose combines the chain with a
+  // fit to the keyframe, whose errors are largely independent (docs/algorithm.md §7.3): six
+  // seeds 0.050 without keyframes, 0.038 with them (0.76 x).
   const std::string folder = dynvo::test::sharedDataPath("tum_fr1_desk_fast");
   DYNVO_REQUIRE_SHARED_DATA(folder + "/groundtruth.txt");
   const dynvo::Trajectory truth = dynvo::readTrajectory(folder + "/groundtruth.txt");
-  const RecordingRun run = runFr1Recording(folder);
-  EXPECT_EQ(std::count(run.lost.begin(), run.lost.end(), true), 0);
-  const auto with = dynvo::computeRpe(truth, run.estimate);
-  const auto without = dynvo::computeRpe(
-      truth, runFr1Recording(folder, [](dynvo::app::PipelineOptions& o) {
-               o.keyframes = false;
-             }).estimate);
-  RecordProperty("rpe_with_keyframes", std::to_string(with.trans_rmse));
-  RecordProperty("rpe_without_keyframes", std::to_string(without.trans_rmse));
-  ASSERT_GT(with.pairs, 50u);
-  EXPECT_LE(with.trans_rmse, 0.04);
-  EXPECT_LT(with.trans_rmse, 0.85 * without.trans_rmse);
+  constexpr std::uint32_t SEEDS = 6;
+  double with = 0.0, without = 0.0;
+  for (std::uint32_t seed = 0; seed < SEEDS; ++seed) {
+    const auto seeded = [seed](dynvo::app::PipelineOptions& o) {
+      o.segmentation.seed = seed;
+    };
+    const RecordingRun run = runFr1Recording(folder, seeded);
+    EXPECT_EQ(std::count(run.lost.begin(), run.lost.end(), true), 0) << "seed " << seed;
+    const auto rpe = dynvo::computeRpe(truth, run.estimate);
+    ASSERT_GT(rpe.pairs, 50u);
+    with += rpe.trans_rmse / SEEDS;
+    without +=
+        dynvo::computeRpe(truth, runFr1Recording(folder,
+                                                 [&](dynvo::app::PipelineOptions& o) {
+                                                   seeded(o);
+                                                   o.keyframes = false;
+                                                 })
+                                     .estimate)
+            .trans_rmse /
+        SEEDS;
+  }
+  RecordProperty("rpe_with_keyframes", std::to_string(with));
+  RecordProperty("rpe_without_keyframes", std::to_string(without));
+  EXPECT_LE(with, 0.04);
+  EXPECT_LT(with, 0.85 * without);
+}
+
+/// The synthetic `scenario`'s objects composited into the first 120 frames of the TUM fr1
+/// recording `folder`, written under `dir`; returns the sequence folder.
+std::string
+compositeIntoRecording(const std::string& scenario,
+                       const std::string& folder,
+                       const dynvo::test::TempDir& dir)
+{
+  dynvo::SynthOptions options;
+  options.scenario = scenario;
+  dynvo::app::CompositeOptions composite;
+  composite.recording = folder;
+  composite.intrinsics = fr1SourceOptions().intrinsics;
+  composite.frames = 120;
+  dynvo::app::writeCompositeSequence(options, composite, dir.file(scenario));
+  return dir.file(scenario);
 }
 
 TEST(OdometryPipeline, CompositedBoxesDoNotPullTheCameraOnARealRecording)
@@ -710,18 +741,11 @@ TEST(OdometryPipeline, CompositedBoxesDoNotPullTheCameraOnARealRecording)
   // pair, so they fall into the background's segment whenever they are not already apart,
   // and, nearer than the desk, outweigh it in the fit: the camera follows them. Their
   // evidence over frames leaves them out of the fits (docs/algorithm.md §7.6). Seeds 0-2:
-  // 0.087-0.105 m/s with the evidence, 0.385-0.567 without; the plain clip reads 0.026.
+  // 0.046-0.072 m/s with the evidence, 0.38 and more without; the plain clip reads 0.021.
   const std::string folder = dynvo::test::sharedDataPath("tum_fr1_xyz_200");
   DYNVO_REQUIRE_SHARED_DATA(folder + "/groundtruth.txt");
   const dynvo::test::TempDir dir;
-  dynvo::SynthOptions options;
-  options.scenario = "static_two";
-  dynvo::app::CompositeOptions composite;
-  composite.recording = folder;
-  composite.intrinsics = fr1SourceOptions().intrinsics;
-  composite.frames = 120;
-  dynvo::app::writeCompositeSequence(options, composite, dir.file("composite"));
-  const std::string sequence = dir.file("composite");
+  const std::string sequence = compositeIntoRecording("static_two", folder, dir);
   const dynvo::Trajectory truth = dynvo::readTrajectory(sequence + "/groundtruth.txt");
   const auto with = dynvo::computeRpe(truth, runFr1Recording(sequence).estimate);
   const auto without = dynvo::computeRpe(
@@ -733,6 +757,29 @@ TEST(OdometryPipeline, CompositedBoxesDoNotPullTheCameraOnARealRecording)
   ASSERT_GT(with.pairs, 50u);
   EXPECT_LE(with.trans_rmse, 0.15);
   EXPECT_LT(with.trans_rmse, 0.4 * without.trans_rmse);
+}
+
+TEST(OdometryPipeline, SlowBoxCompositedIntoARealRecordingDoesNotTakeTheBackgroundLabel)
+{
+  // One textured box (synthetic static_one, 25 cm at about 1.3 m, 7-12 mm per frame)
+  // composited into TUM fr1/xyz, 120 frames: 2-4 sigma off the camera's motion in one frame
+  // pair. When a jerk of the hand-held camera (a constant-velocity prediction off by 2-6
+  // cm) fails the background's segment in the guard, label 1 went to the segment whose
+  // motion was nearest the prediction on its own cells: a sliver of the background or the
+  // box, and the camera followed the box (0.22-0.36 m/s on some seeds). Compared over the
+  // whole scene, with the guard's tolerance following half the ego-motion guard's
+  // widening (docs/algorithm.md §4), six seeds read 0.022-0.032 (the plain clip 0.021 on
+  // seed 0). Bar: 1.5 times issue 29's 0.03, a margin for one seed's spread, far below
+  // a camera that follows the box.
+  const std::string folder = dynvo::test::sharedDataPath("tum_fr1_xyz_200");
+  DYNVO_REQUIRE_SHARED_DATA(folder + "/groundtruth.txt");
+  const dynvo::test::TempDir dir;
+  const std::string sequence = compositeIntoRecording("static_one", folder, dir);
+  const dynvo::Trajectory truth = dynvo::readTrajectory(sequence + "/groundtruth.txt");
+  const auto rpe = dynvo::computeRpe(truth, runFr1Recording(sequence).estimate);
+  RecordProperty("rpe", std::to_string(rpe.trans_rmse));
+  ASSERT_GT(rpe.pairs, 50u);
+  EXPECT_LE(rpe.trans_rmse, 0.045);
 }
 
 TEST(OdometryPipeline, NoiseFollowingThresholdBoundsAreValidated)

@@ -204,13 +204,14 @@ struct OdometryPipeline::Impl {
     frame_flow = flow;
 
     const auto segmentation_start = Clock::now();
-    // The ego-motion guard's tolerance grows with the predicted motion (docs/algorithm.md
-    // §7); the segmentation's background guard keeps tau_cv.
-    selection.setMotionGuardTolerance(
-        options.segmentation.static_guard_tolerance +
-        options.guard_motion_factor *
-            predictedDisplacement(*flow, T_curr_prev_predicted));
+    // The guards' tolerances grow with the predicted motion (docs/algorithm.md §4, §7): the
+    // ego-motion guard's by rho D_pred, the segmentation's background guard's by half that.
+    const double tau_cv = options.segmentation.static_guard_tolerance;
+    const double widening = options.guard_motion_factor *
+                            predictedDisplacement(*flow, T_curr_prev_predicted);
+    selection.setMotionGuardTolerance(tau_cv + widening);
     if (options.use_segmentation) {
+      segmentation.setStaticGuardTolerance(static_cast<float>(tau_cv + 0.5 * widening));
       result.inlier_threshold = noise_tracker.getInlierThreshold();
       segmentation.setInlierThreshold(static_cast<float>(result.inlier_threshold));
       segmentation.setInputCloud(cloud);

@@ -261,23 +261,35 @@ SegmentTracker::guardBackground(const GridFlowData& grid,
     return;
   // r_pred(c): RMS residual of segment c under the constant-velocity prediction (metres).
   // [D] Sensor model: RMS distance between where the segment's motion and the prediction
-  // move its points, so that depth noise (3 cm at 4 m) does not count as a departure.
+  // move the points of every valid cell of the frame, so that depth noise (3 cm at 4 m)
+  // does not count as a departure, and so that motions are compared over one scene: over
+  // its own few cells a small segment's fit can agree with any motion (a sliver of the
+  // background trades rotation for translation), over the whole scene it cannot.
   const bool sensor = !grid.information.empty();
   std::vector<double> sum(g + 1, 0.0);
+  std::size_t valid = 0;
   for (std::size_t i = 0; i < grid.size(); ++i) {
-    const int c = spatial.labels[i];
-    if (c == 0)
-      continue;
     const Eigen::Vector3d a = grid.a[i].cast<double>();
-    const Eigen::Vector3d b =
-        sensor ? Eigen::Vector3d((spatial.motions[c - 1] * a.homogeneous()).head<3>())
-               : grid.b[i].cast<double>();
-    sum[c] += squaredTransferError(T_pred, a, b);
+    if (sensor) {
+      if (!grid.valid_3d[i])
+        continue;
+      ++valid;
+      for (int c = 1; c <= g; ++c)
+        sum[c] += squaredTransferError(
+            T_pred, a,
+            Eigen::Vector3d((spatial.motions[c - 1] * a.homogeneous()).head<3>()));
+    }
+    else if (spatial.labels[i] != 0) {
+      sum[spatial.labels[i]] +=
+          squaredTransferError(T_pred, a, grid.b[i].cast<double>());
+    }
   }
   int c1 = 0, best = 0;
   std::vector<double> r(g + 1, 0.0);
   for (int c = 1; c <= g; ++c) {
-    r[c] = std::sqrt(sum[c] / spatial.sizes[c - 1]);
+    r[c] =
+        std::sqrt(sum[c] / static_cast<double>(sensor ? std::max<std::size_t>(valid, 1)
+                                                      : spatial.sizes[c - 1]));
     if (ids[c] == LABEL_STATIC)
       c1 = c;
     if (spatial.sizes[c - 1] >= params.static_min_cells &&
