@@ -355,6 +355,44 @@ TEST(ObjectBirth, ObjectOfTwoFramesIsNeverOutput)
     EXPECT_EQ(outputs[k], (std::vector<std::uint8_t>{1})) << "frame " << k;
 }
 
+TEST(ObjectBirth, NoObjectIsOutputOnAFrameWithoutBackground)
+{
+  // The box moves 4 cm per frame along x; the camera is still. On frame 4 the prediction is
+  // 10 cm off along y (a jerk the constant-velocity model missed): the background departs from
+  // it by 10 cm, the box by about 11 cm, both beyond tau_cv = 3 cm, so no segment is the
+  // background. Nothing was measured to move against a background there, so no object is
+  // output and no pixel is labelled as one; the tracker keeps the box's id, which is output
+  // again on the next frame.
+  dynvo::RigidMotionSegmentation<pcl::PointXYZRGB> segmentation;
+  segmentation.setCameraIntrinsics(dynvo::test::intrinsicsFor(160));
+  for (std::size_t k = 0; k < 7; ++k) {
+    segmentation.setPredictedMotion(
+        k == 4
+            ? Eigen::Matrix4f(dynvo::test::makeMotion({0, 0, 1}, 0.0, {0.0, 0.10, 0.0})
+                                  .cast<float>())
+            : Eigen::Matrix4f::Identity());
+    const auto [segments, truth] = segmentBoxFrame(segmentation, 4, 0.04, k);
+    const std::vector<std::uint8_t>& pixels = segmentation.getPixelLabels();
+    const auto objects =
+        std::count_if(pixels.begin(), pixels.end(), [](std::uint8_t label) {
+          return label > 1;
+        });
+    if (k == 4) {
+      EXPECT_EQ(segmentation.getSegmentLabels(), (std::vector<std::uint8_t>{1}));
+      EXPECT_EQ(segments.size(), 1u);
+      EXPECT_EQ(objects, 0);
+      const std::vector<std::uint8_t>& cells = segmentation.getCellLabels();
+      EXPECT_EQ(std::count(cells.begin(), cells.end(), 1), 0);
+      EXPECT_GT(std::count(cells.begin(), cells.end(), 2), 0);
+    }
+    else if (k > 0) { // frame 0 starts the sequence: not checked here
+      EXPECT_EQ(segmentation.getSegmentLabels(), (std::vector<std::uint8_t>{1, 2}))
+          << "frame " << k;
+      EXPECT_GT(objects, 0) << "frame " << k;
+    }
+  }
+}
+
 /// Majority output label over the box's cells while a box (8 x 14 cells at 1.2 m) moves by
 /// `steps[k]` metres along x in frame k: one cell column per frame while fast (4 cm at 1.2 m is
 /// 4.4 px), in place when slow. Flow noise 0.5 mm per axis, a new draw every frame.

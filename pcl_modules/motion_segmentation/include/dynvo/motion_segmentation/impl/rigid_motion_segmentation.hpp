@@ -219,19 +219,25 @@ RigidMotionSegmentation<PointT>::segment(std::vector<pcl::PointIndices>& segment
                     params_);
     cell_grid_.labels = tracker_.labels();
     // [D] Objects younger than n_birth frames are not output yet: most spurious objects of
-    // a real static scene last one to three frames.
-    std::array<bool, 256> young{};
+    // a real static scene last one to three frames. Nor is any object on a frame without a
+    // background (no segment agrees with the prediction, §4): nothing was measured to move
+    // against it. The tracker keeps the ids for the next frames.
+    const bool background =
+        std::find(cell_grid_.labels.begin(), cell_grid_.labels.end(), LABEL_STATIC) !=
+        cell_grid_.labels.end();
+    std::array<bool, 256> held{};
     for (std::size_t s = 0; s < tracker_.ids().size(); ++s) {
       const std::uint8_t id = tracker_.ids()[s];
-      young[id] = id != LABEL_STATIC && tracker_.age(id) < params_.object_birth_frames;
-      if (young[id])
+      held[id] = id != LABEL_STATIC &&
+                 (!background || tracker_.age(id) < params_.object_birth_frames);
+      if (held[id])
         continue;
       segment_labels_.push_back(id);
       motions_.push_back(tracker_.motions()[s].cast<float>());
     }
     output_grid_ = cell_grid_;
     for (std::uint8_t& label : output_grid_.labels)
-      label = young[label] ? LABEL_STATIC : label;
+      label = held[label] ? LABEL_STATIC : label;
   }
   else {
     // Two-frame result: segments by size, the largest taken as the background.
