@@ -126,10 +126,9 @@ public:
 
   /** \brief Label per grid cell (row-major, cols x rows of the flow): 0 none, 1 static, 2..
    * objects, the cells the ego-motion fit takes as static being those labelled 1. An object
-   * younger than object_birth_frames is here but not yet in the segments, the pixel labels or
-   * getSegmentLabels() (its pixels are static there). A frame with no cell labelled 1 has no
-   * background to measure motion against: its objects are here, but the segments hold only
-   * an empty background and every pixel label is 0.
+   * younger than object_birth_frames, and every object of a frame with no cell labelled 1, is
+   * here but not in the segments, the pixel labels or getSegmentLabels() (its pixels are
+   * static there).
    */
   const std::vector<std::uint8_t>& getCellLabels() const { return cell_grid_.labels; }
 

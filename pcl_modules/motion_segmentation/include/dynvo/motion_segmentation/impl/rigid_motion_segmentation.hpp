@@ -214,17 +214,15 @@ RigidMotionSegmentation<PointT>::segment(std::vector<pcl::PointIndices>& segment
   PCL_DEBUG("[dynvo::%s::segment] %d segments from %zu hypotheses (%d trials).\n",
             getClassName().c_str(), spatial_.segmentCount(), spatial_.hypotheses.size(),
             spatial_.trials);
-  bool background = true; // a cell of the tracked labels is static (always without tracking)
   if (params_.tracking) {
     tracker_.update(grid_, spatial_, predicted_motion_.cast<double>(), intrinsics_,
                     params_);
     cell_grid_.labels = tracker_.labels();
     // [D] Objects younger than n_birth frames are not output yet: most spurious objects of
     // a real static scene last one to three frames. Nor is any object on a frame without a
-    // background (no segment agrees with the prediction, §4): nothing was measured to be
-    // static or to move against it, and the frame is output unlabelled. The tracker keeps
-    // the ids for the next frames.
-    background =
+    // background (no segment agrees with the prediction, §4): nothing was measured to move
+    // against it. The tracker keeps the ids for the next frames.
+    const bool background =
         std::find(cell_grid_.labels.begin(), cell_grid_.labels.end(), LABEL_STATIC) !=
         cell_grid_.labels.end();
     std::array<bool, 256> held{};
@@ -239,7 +237,7 @@ RigidMotionSegmentation<PointT>::segment(std::vector<pcl::PointIndices>& segment
     }
     output_grid_ = cell_grid_;
     for (std::uint8_t& label : output_grid_.labels)
-      label = !background ? LABEL_NONE : held[label] ? LABEL_STATIC : label;
+      label = held[label] ? LABEL_STATIC : label;
   }
   else {
     // Two-frame result: segments by size, the largest taken as the background.
@@ -254,12 +252,6 @@ RigidMotionSegmentation<PointT>::segment(std::vector<pcl::PointIndices>& segment
     output_grid_ = cell_grid_;
   }
   updateNoiseScale();
-  if (!background) {
-    pixel_labels_.assign(input_->size(), LABEL_NONE);
-    segments.assign(1, pcl::PointIndices());
-    segments[0].header = input_->header;
-    return;
-  }
   computeImplPixelLabels();
   computeImplIndices(segments);
 }
