@@ -717,9 +717,15 @@ TEST(OdometryPipeline, FastRealMotionIsTrackedAndKeyframesHelp)
   EXPECT_LT(with, 0.85 * without);
 }
 
+/// A composited sequence: its folder and its ground truth.
+struct CompositeSequence {
+  std::string folder;
+  dynvo::Trajectory truth;
+};
+
 /// The synthetic `scenario`'s objects composited into the first 120 frames of the TUM fr1
-/// recording `folder`, written under `dir`; returns the sequence folder.
-std::string
+/// recording `folder`, written under `dir`.
+CompositeSequence
 compositeIntoRecording(const std::string& scenario,
                        const std::string& folder,
                        const dynvo::test::TempDir& dir)
@@ -731,7 +737,7 @@ compositeIntoRecording(const std::string& scenario,
   composite.intrinsics = fr1SourceOptions().intrinsics;
   composite.frames = 120;
   dynvo::app::writeCompositeSequence(options, composite, dir.file(scenario));
-  return dir.file(scenario);
+  return {dir.file(scenario), dynvo::readTrajectory(dir.file(scenario) + "/groundtruth.txt")};
 }
 
 TEST(OdometryPipeline, CompositedBoxesDoNotPullTheCameraOnARealRecording)
@@ -745,8 +751,7 @@ TEST(OdometryPipeline, CompositedBoxesDoNotPullTheCameraOnARealRecording)
   const std::string folder = dynvo::test::sharedDataPath("tum_fr1_xyz_200");
   DYNVO_REQUIRE_SHARED_DATA(folder + "/groundtruth.txt");
   const dynvo::test::TempDir dir;
-  const std::string sequence = compositeIntoRecording("static_two", folder, dir);
-  const dynvo::Trajectory truth = dynvo::readTrajectory(sequence + "/groundtruth.txt");
+  const auto [sequence, truth] = compositeIntoRecording("static_two", folder, dir);
   const auto with = dynvo::computeRpe(truth, runFr1Recording(sequence).estimate);
   const auto without = dynvo::computeRpe(
       truth, runFr1Recording(sequence, [](dynvo::app::PipelineOptions& o) {
@@ -774,8 +779,7 @@ TEST(OdometryPipeline, SlowBoxCompositedIntoARealRecordingDoesNotTakeTheBackgrou
   const std::string folder = dynvo::test::sharedDataPath("tum_fr1_xyz_200");
   DYNVO_REQUIRE_SHARED_DATA(folder + "/groundtruth.txt");
   const dynvo::test::TempDir dir;
-  const std::string sequence = compositeIntoRecording("static_one", folder, dir);
-  const dynvo::Trajectory truth = dynvo::readTrajectory(sequence + "/groundtruth.txt");
+  const auto [sequence, truth] = compositeIntoRecording("static_one", folder, dir);
   const auto rpe = dynvo::computeRpe(truth, runFr1Recording(sequence).estimate);
   RecordProperty("rpe", std::to_string(rpe.trans_rmse));
   ASSERT_GT(rpe.pairs, 50u);
