@@ -296,6 +296,26 @@ struct OdometryPipeline::Impl {
     return shareWithinBound(T_curr_prev, step_dt, options) >= 1.0;
   }
 
+  /** Segments a frame without a background again against its measured step (docs/algorithm.md
+   * §4): the guard's reference is the best motion estimate there is, the prediction before
+   * the fit and the fit itself after it, within tau_cv (the measured step has no prediction
+   * error to widen for).
+   */
+  void resegment()
+  {
+    const auto start = Clock::now();
+    segmentation.setPredictedMotion(result.T_curr_prev.cast<float>());
+    segmentation.setStaticGuardTolerance(
+        static_cast<float>(options.segmentation.static_guard_tolerance));
+    segmentation.resegment(result.segments);
+    PCL_DEBUG("[dynvo::app::OdometryPipeline] frame %zu: segmented again against the "
+              "measured step, %s background\n",
+              frames, segmentation.hasBackground() ? "a" : "still no");
+    result.segment_labels = segmentation.getSegmentLabels();
+    result.motions = segmentation.getMotions();
+    result.times.segmentation_ms += millisecondsSince(start);
+  }
+
   /// The fit to the keyframe, seeded with the frame-to-frame estimate (or the prediction).
   void registerToKeyframe(const Cloud::ConstPtr& cloud)
   {
@@ -547,6 +567,8 @@ OdometryPipeline::process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& clo
     }
     if (result.lost)
       p.recoverDense(cloud);
+    else if (p.options.use_segmentation && !p.segmentation.hasBackground())
+      p.resegment();
     // Every pose is rigid: a product that drifts off SO(3) makes rigidInverse() inexact, and
     // the last step, taken from two poses, feeds the error back through the prediction on
     // lost frames until it diverges (docs/algorithm.md §7.5).

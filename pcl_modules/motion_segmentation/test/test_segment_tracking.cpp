@@ -393,6 +393,59 @@ TEST(ObjectBirth, NoObjectIsOutputOnAFrameWithoutBackground)
   }
 }
 
+TEST(BackgroundGuard, ResegmentAgainstTheMeasuredMotionRecoversTheFrame)
+{
+  // The frame of the test above: the prediction is 10 cm off, so no segment is the
+  // background. resegment() with the camera's measured motion (identity: it is still) runs
+  // the tracking of that frame again from the state before it: the output, the cell labels
+  // and the state carried to the next frames must be those of a run whose prediction was
+  // right all along (the tracker's state is restored, not updated twice).
+  const auto still = Eigen::Matrix4f::Identity().eval();
+  const Eigen::Matrix4f jerk =
+      dynvo::test::makeMotion({0, 0, 1}, 0.0, {0.0, 0.10, 0.0}).cast<float>();
+  dynvo::RigidMotionSegmentation<pcl::PointXYZRGB> resegmented, reference;
+  for (auto* segmentation : {&resegmented, &reference})
+    segmentation->setCameraIntrinsics(dynvo::test::intrinsicsFor(160));
+  for (std::size_t k = 0; k < 7; ++k) {
+    resegmented.setPredictedMotion(k == 4 ? jerk : still);
+    reference.setPredictedMotion(still);
+    auto segments = segmentBoxFrame(resegmented, 4, 0.04, k).first;
+    const auto expected = segmentBoxFrame(reference, 4, 0.04, k).first;
+    if (k == 4) {
+      EXPECT_FALSE(resegmented.hasBackground());
+      resegmented.setPredictedMotion(still);
+      resegmented.resegment(segments);
+      EXPECT_TRUE(resegmented.hasBackground());
+    }
+    ASSERT_EQ(segments.size(), expected.size()) << "frame " << k;
+    for (std::size_t s = 0; s < segments.size(); ++s)
+      EXPECT_EQ(segments[s].indices, expected[s].indices) << "frame " << k;
+    EXPECT_EQ(resegmented.getSegmentLabels(), reference.getSegmentLabels())
+        << "frame " << k;
+    EXPECT_EQ(resegmented.getCellLabels(), reference.getCellLabels()) << "frame " << k;
+    EXPECT_EQ(resegmented.getNoiseGains(), reference.getNoiseGains()) << "frame " << k;
+    const dynvo::DualLabelModel& model = resegmented.getTracker().model();
+    const dynvo::DualLabelModel& expected_model = reference.getTracker().model();
+    for (std::size_t cell = 0; cell < resegmented.getCellLabels().size(); ++cell)
+      for (const auto m : {dynvo::DualLabelModel::Model::apparent,
+                           dynvo::DualLabelModel::Model::candidate})
+        ASSERT_EQ(model.age(m, cell), expected_model.age(m, cell))
+            << "frame " << k << " cell " << cell;
+    if (k > 0)
+      EXPECT_EQ(resegmented.getSegmentLabels(), (std::vector<std::uint8_t>{1, 2}))
+          << "frame " << k;
+  }
+}
+
+TEST(BackgroundGuard, ResegmentWithoutASegmentGivesNothing)
+{
+  dynvo::RigidMotionSegmentation<pcl::PointXYZRGB> segmentation;
+  std::vector<pcl::PointIndices> segments(2);
+  segmentation.resegment(segments);
+  EXPECT_TRUE(segments.empty());
+  EXPECT_FALSE(segmentation.hasBackground());
+}
+
 /// Majority output label over the box's cells while a box (8 x 14 cells at 1.2 m) moves by
 /// `steps[k]` metres along x in frame k: one cell column per frame while fast (4 cm at 1.2 m is
 /// 4.4 px), in place when slow. Flow noise 0.5 mm per axis, a new draw every frame.

@@ -105,6 +105,19 @@ public:
   void segment(std::vector<pcl::PointIndices>& segments,
                pcl::PointCloud<pcl::Label>& labels);
 
+  /** \brief Runs the tracking of the last segment() again from the state before it, with the
+   * predicted motion and the guard tolerance set now (the two-frame segmentation is kept).
+   *
+   * For a frame on which no segment agreed with the prediction (hasBackground() false): its
+   * measured ego-motion is a better reference for the background guard (docs/algorithm.md §4).
+   * \param[out] segments as segment(); empty, and nothing changed, when the last segment()
+   *             gave no output
+   */
+  void resegment(std::vector<pcl::PointIndices>& segments);
+
+  /// A cell of the last segment() holds label 1: the guard found the background.
+  bool hasBackground() const;
+
   /// Label of every pixel of the last segment() (row * width + col; 0 no depth), after
   /// PixelLabelRefinement; empty when the inputs broke the contract.
   const std::vector<std::uint8_t>& getPixelLabels() const { return pixel_labels_; }
@@ -227,6 +240,9 @@ protected:
   /// Pixel labels from the cell labels (PixelLabelRefinement), into pixel_labels_.
   void computeImplPixelLabels();
 
+  /// Tracking (or the two-frame result), noise gains, pixel labels and indices of segment().
+  void computeImplLabels(std::vector<pcl::PointIndices>& segments);
+
   /// Fills segments with the pixels of each label of pixel_labels_, in segment_labels_ order.
   void computeImplIndices(std::vector<pcl::PointIndices>& segments) const;
 
@@ -257,6 +273,7 @@ private:
   SpatialSegmenter segmenter_;               ///< §3 with its scratch buffers
   SpatialSegmentationResult spatial_;        ///< §3 result of the last frame
   SegmentTracker tracker_;                   ///< §4-§6 state across frames
+  SegmentTracker tracker_before_; ///< tracker_ before the last frame (resegment())
   FlowGrid cell_grid_;                       ///< geometry and label per cell (the fit's)
   FlowGrid output_grid_; ///< cell_grid_ with objects younger than n_birth static
   std::vector<std::uint8_t> segment_labels_; ///< id of each output segment
@@ -266,6 +283,7 @@ private:
   /// s_axial, s_lateral: the sensor model's gains on its axial and lateral sigma, fitted
   /// over the frames
   std::array<float, 2> noise_gains_{1.0f, 1.0f};
+  std::array<float, 2> noise_gains_before_{1.0f, 1.0f}; ///< before the last frame
 };
 
 } // namespace dynvo

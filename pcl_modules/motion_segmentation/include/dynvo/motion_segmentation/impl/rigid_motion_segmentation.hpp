@@ -214,6 +214,38 @@ RigidMotionSegmentation<PointT>::segment(std::vector<pcl::PointIndices>& segment
   PCL_DEBUG("[dynvo::%s::segment] %d segments from %zu hypotheses (%d trials).\n",
             getClassName().c_str(), spatial_.segmentCount(), spatial_.hypotheses.size(),
             spatial_.trials);
+  tracker_before_ = tracker_;
+  noise_gains_before_ = noise_gains_;
+  computeImplLabels(segments);
+}
+
+template <typename PointT>
+void
+RigidMotionSegmentation<PointT>::resegment(std::vector<pcl::PointIndices>& segments)
+{
+  segments.clear();
+  if (output_grid_.labels.empty())
+    return; // no segment() output to run again
+  segment_labels_.clear();
+  motions_.clear();
+  tracker_ = tracker_before_;
+  noise_gains_ = noise_gains_before_;
+  computeImplLabels(segments);
+}
+
+template <typename PointT>
+bool
+RigidMotionSegmentation<PointT>::hasBackground() const
+{
+  const std::vector<std::uint8_t>& labels = cell_grid_.labels;
+  return std::find(labels.begin(), labels.end(), LABEL_STATIC) != labels.end();
+}
+
+template <typename PointT>
+void
+RigidMotionSegmentation<PointT>::computeImplLabels(
+    std::vector<pcl::PointIndices>& segments)
+{
   if (params_.tracking) {
     tracker_.update(grid_, spatial_, predicted_motion_.cast<double>(), intrinsics_,
                     params_);
@@ -222,9 +254,7 @@ RigidMotionSegmentation<PointT>::segment(std::vector<pcl::PointIndices>& segment
     // a real static scene last one to three frames. Nor is any object on a frame without a
     // background (no segment agrees with the prediction, §4): nothing was measured to move
     // against it. The tracker keeps the ids for the next frames.
-    const bool background =
-        std::find(cell_grid_.labels.begin(), cell_grid_.labels.end(), LABEL_STATIC) !=
-        cell_grid_.labels.end();
+    const bool background = hasBackground();
     std::array<bool, 256> held{};
     for (std::size_t s = 0; s < tracker_.ids().size(); ++s) {
       const std::uint8_t id = tracker_.ids()[s];
