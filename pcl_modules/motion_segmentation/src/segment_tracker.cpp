@@ -284,6 +284,17 @@ SegmentTracker::guardBackground(const GridFlowData& grid,
           squaredTransferError(T_pred, a, grid.b[i].cast<double>());
     }
   }
+  // [D] Label 1 moves from a tracked background only to a segment of at least half its
+  // cells (and n_static_min): a background does not lose half of itself in one frame. When
+  // the former background fails the guard and only a smaller segment agrees with H_pred,
+  // that is a sliver whose motion happens to pass (a blurred frame after a dropped one,
+  // H_pred 5 cm off); the frame then has no background, and the pipeline segments it again
+  // against its measured step. The first pair's label 1 is a guess, not a tracked
+  // background (the paper model's largest segment may be a box covering most of the image).
+  int min_cells = params.static_min_cells;
+  for (int c = 1; c <= g; ++c)
+    if (ids[c] == LABEL_STATIC && hasHistory())
+      min_cells = std::max(min_cells, (spatial.sizes[c - 1] + 1) / 2);
   int c1 = 0, best = 0;
   std::vector<double> r(g + 1, 0.0);
   for (int c = 1; c <= g; ++c) {
@@ -292,8 +303,7 @@ SegmentTracker::guardBackground(const GridFlowData& grid,
                                                       : spatial.sizes[c - 1]));
     if (ids[c] == LABEL_STATIC)
       c1 = c;
-    if (spatial.sizes[c - 1] >= params.static_min_cells &&
-        (best == 0 || r[c] < r[best]))
+    if (spatial.sizes[c - 1] >= min_cells && (best == 0 || r[c] < r[best]))
       best = c;
   }
   const double tau = params.static_guard_tolerance;
