@@ -19,6 +19,7 @@
 #include <chrono>
 #include <cmath>
 #include <deque>
+#include <future>
 #include <stdexcept>
 
 namespace dynvo::app {
@@ -158,7 +159,9 @@ struct OdometryPipeline::Impl {
     flow_estimation.setNumberOfThreads(options.threads);
     segmentation.setCameraIntrinsics(options.intrinsics);
     segmentation.setParameters(options.segmentation);
-    segmentation.setNumberOfThreads(options.threads);
+    // The pixel stage runs beside the fits on the second thread (startSegments()); stripes of
+    // its own would only compete with them.
+    segmentation.setNumberOfThreads(1);
     registration.setParameters(options.registration);
     keyframe_registration.setParameters(options.registration);
     const auto focal =
@@ -217,7 +220,7 @@ struct OdometryPipeline::Impl {
       segmentation.setInputCloud(cloud);
       segmentation.setInputFlow(flow);
       segmentation.setPredictedMotion(T_curr_prev_predicted.cast<float>());
-      segmentation.segment(result.segments);
+      segmentation.segmentCells();
       result.segment_labels = segmentation.getSegmentLabels();
       result.motions = segmentation.getMotions();
       selection.setCellLabels(segmentation.getCellGrid());
@@ -229,6 +232,8 @@ struct OdometryPipeline::Impl {
       selection.clearCellLabels();
     }
     result.times.segmentation_ms = millisecondsSince(segmentation_start);
+    if (options.use_segmentation)
+      startSegments();
 
     const auto registration_start = Clock::now();
     registration.setInputSource(cloud);
@@ -314,6 +319,29 @@ struct OdometryPipeline::Impl {
     result.segment_labels = segmentation.getSegmentLabels();
     result.motions = segmentation.getMotions();
     result.times.segmentation_ms += millisecondsSince(start);
+  }
+
+  /** The segmentation's pixel stage (pixel labels and indices): nothing the fits do depends
+   * on it (they take cells), so with a second thread it runs beside them until
+   * finishSegments(). Its time counts in segmentation_ms, so with two threads the stages can
+   * add up to more than the frame's total.
+   */
+  void startSegments()
+  {
+    const auto pixel_stage = [this] {
+      const auto start = Clock::now();
+      segmentation.computeSegments(result.segments);
+      return millisecondsSince(start);
+    };
+    segments_ms = options.threads > 1 ? std::async(std::launch::async, pixel_stage)
+                                      : std::async(std::launch::deferred, pixel_stage);
+  }
+
+  /// Waits for startSegments(); nothing before it may touch the segmentation or the segments.
+  void finishSegments()
+  {
+    if (segments_ms.valid())
+      result.times.segmentation_ms += segments_ms.get();
   }
 
   /// The fit to the keyframe, seeded with the frame-to-frame estimate (or the prediction).
@@ -466,7 +494,8 @@ struct OdometryPipeline::Impl {
   static constexpr std::size_t MIN_DEPARTURES = 5; ///< fewer: the mean, unconditionally
   std::deque<double> departures; ///< the last departures (metres), oldest first
   StaticSetSelection<pcl::PointXYZRGB> selection;
-  MotionEvidence evidence; ///< cells left out of the fits (with segmentation)
+  MotionEvidence evidence;         ///< cells left out of the fits (with segmentation)
+  std::future<double> segments_ms; ///< the pixel stage of this frame (startSegments())
   pcl::PointCloud<PointFlow>::ConstPtr
       frame_flow; ///< this frame's flow to the previous
   InlierNoiseTracker noise_tracker;
@@ -565,6 +594,7 @@ OdometryPipeline::process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& clo
       p.trackKeyframe(cloud);
       result.T_curr_prev = rigidInverse(result.T_world_curr) * p.T_world_prev;
     }
+    p.finishSegments();
     if (result.lost)
       p.recoverDense(cloud);
     else if (p.options.use_segmentation && !p.segmentation.hasBackground())

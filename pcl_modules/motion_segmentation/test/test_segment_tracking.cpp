@@ -15,6 +15,7 @@
 #include <array>
 #include <numeric>
 #include <random>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -273,14 +274,14 @@ TEST_F(BoxSequence, BoxCoveringMostOfTheImageDoesNotTakeTheBackgroundLabel)
   EXPECT_TRUE(segmentation.getMotions()[0].isIdentity(1e-4f));
 }
 
-/// Segments frame k of a box (8 x 14 cells at 1.2 m from column col0, 160 x 120, 4 px cells)
+/// Sets frame k of a box (8 x 14 cells at 1.2 m from column col0, 160 x 120, 4 px cells)
 /// moving `step` metres along x before a static background, with flow noise 0.5 mm per axis
-/// (a new draw every frame); returns the segments and the true label of each cell.
-std::pair<std::vector<pcl::PointIndices>, std::vector<int>>
-segmentBoxFrame(dynvo::RigidMotionSegmentation<pcl::PointXYZRGB>& segmentation,
-                int col0,
-                double step,
-                std::size_t k)
+/// (a new draw every frame), as the input; returns the true label of each cell.
+std::vector<int>
+setBoxFrame(dynvo::RigidMotionSegmentation<pcl::PointXYZRGB>& segmentation,
+            int col0,
+            double step,
+            std::size_t k)
 {
   constexpr int CELL = 4;
   const auto synthetic = dynvo::test::makeSyntheticFlow(
@@ -291,9 +292,64 @@ segmentBoxFrame(dynvo::RigidMotionSegmentation<pcl::PointXYZRGB>& segmentation,
   segmentation.setInputCloud(
       dynvo::test::cloudFromFlow<pcl::PointXYZRGB>(*synthetic.flow, CELL));
   segmentation.setInputFlow(synthetic.flow);
+  return synthetic.truth;
+}
+
+/// Segments the frame of setBoxFrame(); returns the segments and the true label of each cell.
+std::pair<std::vector<pcl::PointIndices>, std::vector<int>>
+segmentBoxFrame(dynvo::RigidMotionSegmentation<pcl::PointXYZRGB>& segmentation,
+                int col0,
+                double step,
+                std::size_t k)
+{
+  std::vector<int> truth = setBoxFrame(segmentation, col0, step, k);
   std::vector<pcl::PointIndices> segments;
   segmentation.segment(segments);
-  return {segments, synthetic.truth};
+  return {segments, truth};
+}
+
+TEST(CellAndPixelStages, PixelStageOnAnotherThreadGivesTheOutputOfSegment)
+{
+  // segmentCells() then computeSegments() on a second thread, while this one reads the cell
+  // stage's results (as the pipeline's fits do), must give what segment() gives on every
+  // frame of a tracked sequence: the box moves 4 cm per frame from frame 2, so the frames
+  // hold one and then two segments, and the tracker's state is carried between them.
+  dynvo::RigidMotionSegmentation<pcl::PointXYZRGB> split, whole;
+  for (auto* segmentation : {&split, &whole})
+    segmentation->setCameraIntrinsics(dynvo::test::intrinsicsFor(160));
+  int col0 = 4;
+  for (std::size_t k = 0; k < 6; ++k) {
+    const double step = k >= 2 ? 0.04 : 0.0;
+    col0 += step > 0.0 ? 1 : 0;
+    const auto [expected, truth] = segmentBoxFrame(whole, col0, step, k);
+    setBoxFrame(split, col0, step, k);
+    split.segmentCells();
+    EXPECT_TRUE(split.getPixelLabels().empty()) << "frame " << k;
+    std::vector<pcl::PointIndices> segments;
+    std::thread pixel_stage([&] {
+      split.computeSegments(segments);
+    });
+    const bool background = split.hasBackground();
+    const std::vector<std::uint8_t> cells = split.getCellGrid().labels;
+    const std::vector<std::uint8_t> ids = split.getSegmentLabels();
+    pixel_stage.join();
+    EXPECT_EQ(background, whole.hasBackground()) << "frame " << k;
+    EXPECT_EQ(cells, whole.getCellLabels()) << "frame " << k;
+    EXPECT_EQ(ids, whole.getSegmentLabels()) << "frame " << k;
+    EXPECT_EQ(split.getPixelLabels(), whole.getPixelLabels()) << "frame " << k;
+    ASSERT_EQ(segments.size(), expected.size()) << "frame " << k;
+    for (std::size_t s = 0; s < segments.size(); ++s)
+      EXPECT_EQ(segments[s].indices, expected[s].indices) << "frame " << k;
+  }
+  // Not vacuous: the moving box is an object by the last frame.
+  EXPECT_EQ(whole.getSegmentLabels(), (std::vector<std::uint8_t>{1, 2}));
+  // A cell stage without input gives no pixel stage either.
+  dynvo::RigidMotionSegmentation<pcl::PointXYZRGB> empty;
+  empty.segmentCells();
+  std::vector<pcl::PointIndices> segments(2);
+  empty.computeSegments(segments);
+  EXPECT_TRUE(segments.empty());
+  EXPECT_TRUE(empty.getPixelLabels().empty());
 }
 
 /// Output ids per frame while the box of segmentBoxFrame() (from column 4) moves 4 cm per

@@ -197,31 +197,44 @@ GridFlowEngine::prepare(Slot slot,
   frame.velocity.clear();
   frame.preprocessing.setParameters(params.depth);
   frame.preprocessing.setNumberOfThreads(threads);
-  frame.preprocessing.apply(depth, width, height, frame.depth);
-  // b_i's depth at each cell centre c_i: the same for the frame-to-frame and keyframe tracks.
-  const int cell = params.cell_size;
-  const int cols = static_cast<int>(width) / cell,
-            rows = static_cast<int>(height) / cell;
-  const int r = params.depth_window_radius;
-  frame.centre_depth.resize(static_cast<std::size_t>(cols) * rows);
-  for (int row = 0; row < rows; ++row)
-    for (int c = 0; c < cols; ++c) {
-      const int u = c * cell + cell / 2, v = row * cell + cell / 2;
-      float z = centreDepth(frame.depth, static_cast<int>(width),
-                            static_cast<int>(height), u, v);
-      if (r > 0 && !std::isnan(z))
-        z = windowDepth(frame.depth, static_cast<int>(width), static_cast<int>(height),
-                        cv::Point2f(static_cast<float>(u), static_cast<float>(v)), z, r,
-                        params.depth_edge_tolerance);
-      frame.centre_depth[static_cast<std::size_t>(row) * cols + c] = z;
-    }
+  const auto build_depth = [&] {
+    frame.preprocessing.apply(depth, width, height, frame.depth);
+    // b_i's depth at each cell centre c_i: the same for the frame-to-frame and keyframe
+    // tracks.
+    const int cell = params.cell_size;
+    const int cols = static_cast<int>(width) / cell,
+              rows = static_cast<int>(height) / cell;
+    const int r = params.depth_window_radius;
+    frame.centre_depth.resize(static_cast<std::size_t>(cols) * rows);
+    for (int row = 0; row < rows; ++row)
+      for (int c = 0; c < cols; ++c) {
+        const int u = c * cell + cell / 2, v = row * cell + cell / 2;
+        float z = centreDepth(frame.depth, static_cast<int>(width),
+                              static_cast<int>(height), u, v);
+        if (r > 0 && !std::isnan(z))
+          z = windowDepth(frame.depth, static_cast<int>(width),
+                          static_cast<int>(height),
+                          cv::Point2f(static_cast<float>(u), static_cast<float>(v)), z,
+                          r, params.depth_edge_tolerance);
+        frame.centre_depth[static_cast<std::size_t>(row) * cols + c] = z;
+      }
+  };
   // The grey buffer is only read: buildOpticalFlowPyramid copies level 0 into a padded image.
   const cv::Mat image(static_cast<int>(height), static_cast<int>(width), CV_8UC1,
                       const_cast<std::uint8_t*>(grey.data()));
-  runStripes(1, [&](unsigned) {
+  const auto build_pyramid = [&] {
     cv::buildOpticalFlowPyramid(image, frame.pyramid,
                                 cv::Size(params.window_size, params.window_size),
                                 params.max_pyramid_level, true);
+  };
+  // The pyramid and the depth map are independent: with two threads, one each (the
+  // preprocessing's stripes then run serially inside, runStripes()).
+  const unsigned tasks = std::min(threads, 2u);
+  runStripes(tasks, [&](unsigned s) {
+    if (s == 0)
+      build_pyramid();
+    if (s + 1 == tasks)
+      build_depth();
   });
 }
 
@@ -451,7 +464,7 @@ GridFlowEngine::track(const Frame& reference,
   flow.resize(static_cast<std::uint32_t>(cols), static_cast<std::uint32_t>(rows));
   flow.is_dense = false;
   const float max_flow2 = params.max_flow * params.max_flow;
-  for (std::size_t i = 0; i < n; ++i) {
+  const auto finish_cell = [&](std::size_t i) {
     PointFlow& f = flow[i];
     const cv::Point2f c = centres[i];
     const cv::Point2f p = tracked[i];
@@ -467,33 +480,41 @@ GridFlowEngine::track(const Frame& reference,
     f.weight = 0.0f;
     f.valid_3d = 0;
     if (!f.valid_2d || std::isnan(z_b))
-      continue;
+      return;
     // Both ends at their depth instants (docs/algorithm.md §1.2); no offset: where tracked.
     const cv::Point2f c_d = atDepthInstant(c, velocity[i], offset_curr);
     const cv::Point2f p_d = atDepthInstant(p, reference_velocity(i, p), offset_prev);
     if (c_d != c) {
       if (!inside(c_d))
-        continue;
+        return;
       const float z = depthAt(curr.depth, width, height, c_d, r, params);
       if (std::isnan(z))
-        continue;
+        return;
       f.getVector3fMap() = intrinsics.backproject(c_d.x, c_d.y, z);
     }
     if (!inside(p_d))
-      continue;
+      return;
     const float z_a = depthAt(prev.depth, width, height, p_d, r, params);
     if (std::isnan(z_a))
-      continue;
+      return;
     const Eigen::Vector3f a = intrinsics.backproject(p_d.x, p_d.y, z_a);
     if ((f.getVector3fMap() - a).squaredNorm() > max_flow2)
-      continue;
+      return;
     f.prev_x = a.x();
     f.prev_y = a.y();
     f.prev_z = a.z();
     f.valid_3d = 1;
     const float ratio = params.weight_reference_depth / std::max(z_a, f.z);
     f.weight = std::min(1.0f, ratio * ratio * ratio * ratio);
-  }
+  };
+  // Cells are independent: stripes of cells, the same flow for any thread count.
+  const unsigned cell_stripes =
+      static_cast<unsigned>(std::min<std::size_t>(threads, n));
+  runStripes(cell_stripes, [&](unsigned s) {
+    const auto [begin, end] = stripeRange(n, cell_stripes, s);
+    for (std::size_t i = begin; i < end; ++i)
+      finish_cell(i);
+  });
 }
 
 } // namespace detail

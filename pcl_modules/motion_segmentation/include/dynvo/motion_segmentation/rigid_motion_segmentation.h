@@ -97,6 +97,23 @@ public:
    */
   void segment(std::vector<pcl::PointIndices>& segments);
 
+  /** \brief The cell stage of segment(): the tracking and its results per cell (getCellGrid(),
+   * hasBackground(), getSegmentLabels(), getMotions(), the noise gains), without the pixel
+   * labels and indices, which computeSegments() adds; segment(segments) is the two in a row.
+   *
+   * The split lets a caller that needs only the cells next (the ego-motion fit) run
+   * computeSegments() on another thread meanwhile. While it runs, only the const getters of
+   * the cell stage may be called on this object.
+   * \throws std::invalid_argument as segment()
+   */
+  void segmentCells();
+
+  /** \brief The pixel stage of the last segmentCells(): pixel labels
+   * (getPixelLabels()) and the segments.
+   * \param[out] segments as segment(); empty when the cell stage gave no output
+   */
+  void computeSegments(std::vector<pcl::PointIndices>& segments);
+
   /** \brief As segment(segments), and the same pixel labels as an image.
    * \param[out] segments as segment(segments)
    * \param[out] labels organized like the input cloud: 0 no depth (or no labelled cell), 1
@@ -240,8 +257,8 @@ protected:
   /// Pixel labels from the cell labels (PixelLabelRefinement), into pixel_labels_.
   void computeImplPixelLabels();
 
-  /// Tracking (or the two-frame result), noise gains, pixel labels and indices of segment().
-  void computeImplLabels(std::vector<pcl::PointIndices>& segments);
+  /// Tracking (or the two-frame result), cell labels, segment ids, motions and noise gains.
+  void computeImplLabels();
 
   /// Fills segments with the pixels of each label of pixel_labels_, in segment_labels_ order.
   void computeImplIndices(std::vector<pcl::PointIndices>& segments) const;

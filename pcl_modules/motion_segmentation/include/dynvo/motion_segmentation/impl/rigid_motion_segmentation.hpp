@@ -198,6 +198,14 @@ void
 RigidMotionSegmentation<PointT>::segment(std::vector<pcl::PointIndices>& segments)
 {
   segments.clear();
+  segmentCells();
+  computeSegments(segments);
+}
+
+template <typename PointT>
+void
+RigidMotionSegmentation<PointT>::segmentCells()
+{
   clearOutputs();
   params_.validate(); // the per-field setters leave the cross-field rules to here
   if (!initCompute())
@@ -216,7 +224,19 @@ RigidMotionSegmentation<PointT>::segment(std::vector<pcl::PointIndices>& segment
             spatial_.trials);
   tracker_before_ = tracker_;
   noise_gains_before_ = noise_gains_;
-  computeImplLabels(segments);
+  computeImplLabels();
+}
+
+template <typename PointT>
+void
+RigidMotionSegmentation<PointT>::computeSegments(
+    std::vector<pcl::PointIndices>& segments)
+{
+  segments.clear();
+  if (output_grid_.labels.empty())
+    return; // no cell labels to refine
+  computeImplPixelLabels();
+  computeImplIndices(segments);
 }
 
 template <typename PointT>
@@ -230,7 +250,8 @@ RigidMotionSegmentation<PointT>::resegment(std::vector<pcl::PointIndices>& segme
   motions_.clear();
   tracker_ = tracker_before_;
   noise_gains_ = noise_gains_before_;
-  computeImplLabels(segments);
+  computeImplLabels();
+  computeSegments(segments);
 }
 
 template <typename PointT>
@@ -243,8 +264,7 @@ RigidMotionSegmentation<PointT>::hasBackground() const
 
 template <typename PointT>
 void
-RigidMotionSegmentation<PointT>::computeImplLabels(
-    std::vector<pcl::PointIndices>& segments)
+RigidMotionSegmentation<PointT>::computeImplLabels()
 {
   if (params_.tracking) {
     tracker_.update(grid_, spatial_, predicted_motion_.cast<double>(), intrinsics_,
@@ -282,8 +302,6 @@ RigidMotionSegmentation<PointT>::computeImplLabels(
     output_grid_ = cell_grid_;
   }
   updateNoiseScale();
-  computeImplPixelLabels();
-  computeImplIndices(segments);
 }
 
 template <typename PointT>
