@@ -337,10 +337,18 @@ struct OdometryPipeline::Impl {
                                       : std::async(std::launch::deferred, pixel_stage);
   }
 
-  /// Waits for startSegments(); nothing before it may touch the segmentation or the segments.
-  void finishSegments()
+  /** Waits for startSegments(); nothing before it may touch the segmentation or the segments
+   * (hasBackground() and the other const getters of the cell stage aside). A stage not
+   * started yet (one thread) is dropped when not `needed`.
+   */
+  void finishSegments(bool needed)
   {
-    if (segments_ms.valid())
+    if (!segments_ms.valid())
+      return;
+    if (!needed &&
+        segments_ms.wait_for(std::chrono::seconds(0)) == std::future_status::deferred)
+      segments_ms = {};
+    else
       result.times.segmentation_ms += segments_ms.get();
   }
 
@@ -594,10 +602,14 @@ OdometryPipeline::process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& clo
       p.trackKeyframe(cloud);
       result.T_curr_prev = rigidInverse(result.T_world_curr) * p.T_world_prev;
     }
-    p.finishSegments();
+    // A measured frame without a background is segmented again (resegment()), which makes
+    // its own pixel stage: the first one is then not needed.
+    const bool segment_again =
+        !result.lost && p.options.use_segmentation && !p.segmentation.hasBackground();
+    p.finishSegments(!segment_again);
     if (result.lost)
       p.recoverDense(cloud);
-    else if (p.options.use_segmentation && !p.segmentation.hasBackground())
+    else if (segment_again)
       p.resegment();
     // Every pose is rigid: a product that drifts off SO(3) makes rigidInverse() inexact, and
     // the last step, taken from two poses, feeds the error back through the prediction on
