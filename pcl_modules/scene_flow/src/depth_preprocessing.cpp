@@ -104,34 +104,34 @@ DepthPreprocessing::apply(const std::vector<float>& depth,
     throw std::invalid_argument("[dynvo::DepthPreprocessing::apply] out aliases depth");
   out.resize(w * h);
 
-  // Steps 1 and 2 read only the input, so rows are independent. A neighbour q counts when it
-  // passes the range test; "median < lo" and "median > hi" are decided by counting, which avoids
-  // sorting (see the class doc for the median definition):
+  // Steps 1 and 2 read only the input, so rows are independent. A depth outside [z_min, z_max]
+  // is read as NaN (no depth), so that every comparison below is false on it. A neighbour q
+  // counts when it is a number; "median < lo" and "median > hi" are decided by counting,
+  // which avoids sorting (see the class doc for the median definition):
   //   |z - m| > tau m  <=>  m < z / (1 + tau)  or  m > z / (1 - tau)   (m > 0, tau < 1).
   const float z_min = params_.min_depth;
   const float z_max = params_.max_depth;
-  const float tau_fly = params_.flying_pixel_tolerance;
   const auto in_range = [z_min, z_max](float q) {
-    return (q >= z_min) & (q <= z_max);
+    return q >= z_min && q <= z_max ? q : NaN;
   };
-  // Depth kept at pixel (x, y) given its neighbours n[0..count) (branch-free for vectorising).
-  // Reciprocals, so that the per-pixel bounds cost multiplications rather than divisions.
-  const float lo_factor = 1.0f / (1.0f + tau_fly);
-  const float hi_factor = 1.0f / (1.0f - tau_fly);
-  const auto keep = [&](float z, const float* n, int count) {
+  // Depth kept at a pixel of in-range depth z given its in-range neighbours n[0..count)
+  // (branch-free for vectorising). Reciprocals, so that the per-pixel bounds cost
+  // multiplications rather than divisions.
+  const float lo_factor = 1.0f / (1.0f + params_.flying_pixel_tolerance);
+  const float hi_factor = 1.0f / (1.0f - params_.flying_pixel_tolerance);
+  const auto keep = [lo_factor, hi_factor](float z, const float* n, int count) {
     const float lo = z * lo_factor;
     const float hi = z * hi_factor;
     int valid = 0, below = 0, above = 0;
     for (int j = 0; j < count; ++j) {
-      const int ok = in_range(n[j]);
-      valid += ok;
-      below += ok & (n[j] < lo);
-      above += ok & (n[j] > hi);
+      valid += n[j] == n[j];
+      below += n[j] < lo;
+      above += n[j] > hi;
     }
     const int k = valid / 2; // index of the median in the sorted valid neighbours
     const bool flying =
         (valid >= MIN_FLYING_NEIGHBOURS) & ((below >= k + 1) | (above >= valid - k));
-    return in_range(z) && !flying ? z : NaN;
+    return flying ? NaN : z; // NaN stays NaN
   };
   // Border pixels: gather the neighbours that exist.
   const auto border_pixel = [&](std::size_t x, std::size_t y) {
@@ -140,21 +140,34 @@ DepthPreprocessing::apply(const std::vector<float>& depth,
     for (std::size_t yy = y > 0 ? y - 1 : y; yy <= std::min(y + 1, h - 1); ++yy)
       for (std::size_t xx = x > 0 ? x - 1 : x; xx <= std::min(x + 1, w - 1); ++xx)
         if (yy != y || xx != x)
-          n[count++] = depth[yy * w + xx];
-    out[y * w + x] = keep(depth[y * w + x], n, count);
+          n[count++] = in_range(depth[yy * w + xx]);
+    out[y * w + x] = keep(in_range(depth[y * w + x]), n, count);
   };
   detail::runStripes(threads_, [&](unsigned s) {
     const auto [row_begin, row_end] = detail::stripeRange(h, threads_, s);
+    // The in-range depths of rows y - 1, y and y + 1, in a ring of three rows.
+    std::vector<float> ring(3 * w);
+    const auto row_in_range = [&](std::size_t y) {
+      float* row = ring.data() + (y % 3) * w;
+      const float* src = depth.data() + y * w;
+      for (std::size_t x = 0; x < w; ++x)
+        row[x] = in_range(src[x]);
+    };
     for (std::size_t y = row_begin; y < row_end; ++y) {
       if (y == 0 || y + 1 == h || w < 3) {
         for (std::size_t x = 0; x < w; ++x)
           border_pixel(x, y);
         continue;
       }
+      if (y == row_begin || y - 1 == 0) {
+        row_in_range(y - 1);
+        row_in_range(y);
+      }
+      row_in_range(y + 1);
       border_pixel(0, y);
-      const float* up = depth.data() + (y - 1) * w;
-      const float* mid = up + w;
-      const float* down = mid + w;
+      const float* up = ring.data() + ((y - 1) % 3) * w;
+      const float* mid = ring.data() + (y % 3) * w;
+      const float* down = ring.data() + ((y + 1) % 3) * w;
       float* dst = out.data() + y * w;
       for (std::size_t x = 1; x + 1 < w; ++x) {
         const float n[8] = {up[x - 1],  up[x],       up[x + 1], mid[x - 1],
@@ -186,20 +199,35 @@ DepthPreprocessing::apply(const std::vector<float>& depth,
     }
   });
   // Column pass on the row-filled map: stripes own column ranges and walk the rows in order,
-  // remembering the last valid row of every column, which keeps memory access row-major.
+  // remembering the last valid row of every column, which keeps memory access row-major. Each
+  // row first marks the columns that close a gap (branch-free, vectorised), then fills those.
+  const int max_gap_rows = static_cast<int>(std::min(max_gap, h)); // a gap is shorter than h
   detail::runStripes(threads_, [&](unsigned s) {
     const auto [col_begin, col_end] = detail::stripeRange(w, threads_, s);
-    std::vector<std::size_t> last(col_end - col_begin, h);
+    const std::size_t cols = col_end - col_begin;
+    std::vector<int> last(cols, -max_gap_rows - 2); // no valid row yet: any gap too wide
+    std::vector<int> gap_from(cols);
     for (std::size_t y = 0; y < h; ++y) {
-      for (std::size_t x = col_begin; x < col_end; ++x) {
-        const float z = out[y * w + x];
-        if (std::isnan(z))
+      const float* row = out.data() + y * w + col_begin;
+      const int yi = static_cast<int>(y);
+      int closing = 0;
+      for (std::size_t x = 0; x < cols; ++x) {
+        const bool valid = row[x] == row[x];
+        const int l = last[x];
+        const int gap = yi - l - 1;
+        const bool closes = valid & (gap >= 1) & (gap <= max_gap_rows);
+        gap_from[x] = closes ? l : -1;
+        closing += closes;
+        last[x] = valid ? yi : l;
+      }
+      for (std::size_t x = 0; closing > 0 && x < cols; ++x) {
+        const int l = gap_from[x];
+        if (l < 0)
           continue;
-        std::size_t& l = last[x - col_begin];
-        if (l != h && y - l - 1 >= 1 && y - l - 1 <= max_gap &&
-            similar(out[l * w + x], z, tau_fill))
-          fillGap(out.data() + x, l, y, w);
-        l = y;
+        --closing;
+        const std::size_t column = col_begin + x;
+        if (similar(out[static_cast<std::size_t>(l) * w + column], row[x], tau_fill))
+          fillGap(out.data() + column, static_cast<std::size_t>(l), y, w);
       }
     }
   });
