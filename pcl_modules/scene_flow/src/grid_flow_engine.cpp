@@ -197,10 +197,8 @@ GridFlowEngine::prepare(Slot slot,
   frame.velocity.clear();
   frame.preprocessing.setParameters(params.depth);
   frame.preprocessing.setNumberOfThreads(threads);
-  const auto build_depth = [&] {
-    frame.preprocessing.apply(depth, width, height, frame.depth);
-    // b_i's depth at each cell centre c_i: the same for the frame-to-frame and keyframe
-    // tracks.
+  // b_i's depth at each cell centre c_i: the same for the frame-to-frame and keyframe tracks.
+  const auto build_centre_depths = [&] {
     const int cell = params.cell_size;
     const int cols = static_cast<int>(width) / cell,
               rows = static_cast<int>(height) / cell;
@@ -227,14 +225,16 @@ GridFlowEngine::prepare(Slot slot,
                                 cv::Size(params.window_size, params.window_size),
                                 params.max_pyramid_level, true);
   };
-  // The pyramid and the depth map are independent: with two threads, one each (the
-  // preprocessing's stripes then run serially inside, runStripes()).
+  // The depth map first, in stripes on every thread; then the pyramid and the centres'
+  // depths, which are independent: with two threads, one each. (VGA, one thread: the
+  // preprocessing about 0.8 ms, the pyramid 0.3 ms, the centres' depths 0.2 ms.)
+  frame.preprocessing.apply(depth, width, height, frame.depth);
   const unsigned tasks = std::min(threads, 2u);
   runStripes(tasks, [&](unsigned s) {
     if (s == 0)
       build_pyramid();
     if (s + 1 == tasks)
-      build_depth();
+      build_centre_depths();
   });
 }
 
