@@ -201,13 +201,13 @@ DepthPreprocessing::apply(const std::vector<float>& depth,
   // Column pass on the row-filled map: stripes own column ranges and walk the rows in order,
   // remembering the last valid row of every column, which keeps memory access row-major. Each
   // row first marks the columns that close a gap (branch-free, vectorised), then fills those.
-  const int max_gap_rows =
-      static_cast<int>(std::min(max_gap, h)); // a gap is shorter than h
+  // (A gap is shorter than h.)
+  const int max_gap_rows = static_cast<int>(std::min(max_gap, h));
   detail::runStripes(threads_, [&](unsigned s) {
     const auto [col_begin, col_end] = detail::stripeRange(w, threads_, s);
     const std::size_t cols = col_end - col_begin;
-    std::vector<int> last(cols,
-                          -max_gap_rows - 2); // no valid row yet: any gap too wide
+    // The last valid row of each column; before the first, one that makes any gap too wide.
+    std::vector<int> last(cols, -max_gap_rows - 2);
     std::vector<int> gap_from(cols);
     for (std::size_t y = 0; y < h; ++y) {
       const float* row = out.data() + y * w + col_begin;
