@@ -469,7 +469,7 @@ TEST_F(OdometryApp, BadFlagsAndMissingInput)
   EXPECT_EQ(runCommand(run("-bogus")).exit_code, 2);
   const auto backend = runCommand(run("-backend lm"));
   EXPECT_EQ(backend.exit_code, 2);
-  EXPECT_NE(backend.err.find("-backend must be flow|cv_rgbd|icp|gicp, got 'lm'"),
+  EXPECT_NE(backend.err.find("-backend must be flow|cv_rgbd|icp|gicp|direct, got 'lm'"),
             std::string::npos)
       << backend.err;
   const auto reference = runCommand(run("-bench_reference orb"));

@@ -233,7 +233,7 @@ TEST(PipelineFlags, ValuesOutOfRangeAreUsageErrors)
   EXPECT_EQ(message({"-cell_size", "3000000000"}),
             "-cell_size must be a whole number >= 2, got 3e+09");
   EXPECT_EQ(message({"-backend", "lm"}),
-            "-backend must be flow|cv_rgbd|icp|gicp, got 'lm'");
+            "-backend must be flow|cv_rgbd|icp|gicp|direct, got 'lm'");
   EXPECT_EQ(message({"-window_size", "x"}),
             "option '-window_size' expects an integer, got 'x'");
 }

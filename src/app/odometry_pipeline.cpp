@@ -396,27 +396,41 @@ struct OdometryPipeline::Impl {
   }
 
   /** The pose from two measurements (docs/algorithm.md §7.3): the keyframe fit and the
-   * frame-to-frame chain, whose step is fitted again on the cells the keyframe fit kept (a
-   * mover too slow to split off in one frame pair drifts out of the longer baseline's static
-   * set). Their mean, unless they depart from each other by more than 3 times the median
-   * departure of the last DEPARTURE_HISTORY frames: the keyframe fit alone then.
+   * frame-to-frame chain, whose step is fitted again, by the method that made it, on the cells
+   * the keyframe fit kept (a mover too slow to split off in one frame pair drifts out of the
+   * longer baseline's static set). Their mean; with the flow backend, the keyframe fit alone
+   * when they depart from each other by more than 3 times the median departure of the last
+   * DEPARTURE_HISTORY frames.
    */
   Eigen::Matrix4d combineWithChain(const Eigen::Matrix4d& T_world_fit)
   {
     Eigen::Matrix4d T_world_chain = result.T_world_curr;
-    registration.setStaticCells(selection.getStaticCells());
-    pcl::PointCloud<pcl::PointXYZRGB> aligned;
-    registration.align(aligned, rigidInverse(result.T_curr_prev).cast<float>());
-    if (registration.hasConverged())
-      T_world_chain =
-          T_world_prev * registration.getFinalTransformation().cast<double>();
+    const Eigen::Matrix4f T_prev_curr = rigidInverse(result.T_curr_prev).cast<float>();
+    if (options.backend.backend == RegistrationBackend::direct) {
+      // The direct step again, its source pixels those of the keyframe fit's cells.
+      backend.setSourceStaticCells(selection.getStaticCells());
+      Eigen::Matrix4f T_prev_curr_refit;
+      if (backend.align(T_prev_curr, T_prev_curr_refit))
+        T_world_chain = T_world_prev * T_prev_curr_refit.cast<double>();
+    }
+    else {
+      registration.setStaticCells(selection.getStaticCells());
+      pcl::PointCloud<pcl::PointXYZRGB> aligned;
+      registration.align(aligned, T_prev_curr);
+      if (registration.hasConverged())
+        T_world_chain =
+            T_world_prev * registration.getFinalTransformation().cast<double>();
+    }
     const double departure =
         (rigidInverse(T_world_chain) * T_world_fit).topRightCorner<3, 1>().norm();
     std::vector<double> history(departures.begin(), departures.end());
     const auto middle =
         history.begin() + static_cast<std::ptrdiff_t>(history.size() / 2);
     std::nth_element(history.begin(), middle, history.end());
-    const bool apart = history.size() >= MIN_DEPARTURES && departure > 3.0 * *middle;
+    // The direct step's refit keeps a slow mover out of the chain by itself (docs/algorithm.md
+    // §7.3): the test is the flow backend's.
+    const bool apart = options.backend.backend == RegistrationBackend::flow &&
+                       history.size() >= MIN_DEPARTURES && departure > 3.0 * *middle;
     departures.push_back(departure);
     if (departures.size() > DEPARTURE_HISTORY)
       departures.pop_front();
@@ -597,8 +611,10 @@ OdometryPipeline::process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& clo
       p.last_colour_dt = colour_dt;
     p.track(cloud, depth_stamp);
     result.T_world_curr = p.T_world_prev * rigidInverse(result.T_curr_prev);
-    // The keyframe fit is the flow backend's; the other backends run frame to frame.
-    if (p.options.keyframes && p.options.backend.backend == RegistrationBackend::flow) {
+    // The keyframe fit is the flow and direct backends'; the others run frame to frame.
+    if (p.options.keyframes &&
+        (p.options.backend.backend == RegistrationBackend::flow ||
+         p.options.backend.backend == RegistrationBackend::direct)) {
       p.trackKeyframe(cloud);
       result.T_curr_prev = rigidInverse(result.T_world_curr) * p.T_world_prev;
     }

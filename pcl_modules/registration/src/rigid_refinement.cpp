@@ -53,6 +53,7 @@ refineRigidTransformation(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& source
   }
   case RegistrationBackend::flow:
   case RegistrationBackend::cv_rgbd:
+  case RegistrationBackend::direct:
     break;
   }
   return false;

@@ -11,7 +11,8 @@ StaticMaskRegistrationParameters::table()
   using R = FieldRange;
   static_assert(AGGREGATE_FIELD_COUNT<P> == 7, "every field of P needs a row below");
   static const ParameterTable<P> table(std::vector<ParameterTable<P>::Field>{
-      makeChoiceField("backend", &P::backend, {"flow", "cv_rgbd", "icp", "gicp"},
+      makeChoiceField("backend", &P::backend,
+                      {"flow", "cv_rgbd", "icp", "gicp", "direct"},
                       "ego-motion method on the static mask"),
       makeField("icp_max_correspondence_distance", &P::icp_max_correspondence_distance,
                 R::above(0), "metres"),

@@ -5,13 +5,17 @@
 
 #include <dynvo/common/camera.h>
 #include <dynvo/common/flow_grid.h>
+#include <dynvo/registration/direct_odometry.h>
 #include <dynvo/registration/static_mask_registration_parameters.h>
 
 #include <pcl/point_cloud.h>
 
 #include <Eigen/Core>
 
+#include <array>
 #include <cstddef>
+#include <cstdint>
+#include <memory>
 #include <string>
 
 namespace dynvo {
@@ -45,9 +49,14 @@ enum class StaticMaskRegistrationStatus {
  *   frames, with both masks (OpenCV uses the source mask for the points it moves and the
  *   target mask for the textured pixels it compares with), initialised with the guess;
  * - icp, gicp: PCL's ICP/GICP on plain XYZ copies of the finite masked points of both frames
- *   on every icp_stride-th row and column, initialised with the guess.
+ *   on every icp_stride-th row and column, initialised with the guess;
+ * - direct: direct photometric alignment (detail::estimateDirectOdometry()): the textured
+ *   masked pixels of the target, with their depths, moved into the source image where it is
+ *   masked, from the guess over a 3-level pyramid; each cloud's pyramids are built once, for
+ *   its alignments as frame k and as frame k-1.
  * A backend that fails (too few points, not converged) leaves the guess as the result, and
- * getStatus() says why. The camera intrinsics (setCameraIntrinsics()) are used by cv_rgbd.
+ * getStatus() says why. The camera intrinsics (setCameraIntrinsics()) are used by cv_rgbd and
+ * direct.
  * \code
  * dynvo::StaticMaskRegistration<pcl::PointXYZRGB> backend;
  * backend.setCameraIntrinsics(intrinsics);
@@ -136,6 +145,13 @@ private:
   /// cv::rgbd::RgbdOdometry on the masked images; T_prev_curr written when converged.
   Status alignImages(const Eigen::Matrix4f& guess, Eigen::Matrix4f& T_prev_curr);
 
+  /// The direct estimate from the masked frames' pyramids; T_prev_curr written on success.
+  Status alignDirect(const Eigen::Matrix4f& guess, Eigen::Matrix4f& T_prev_curr);
+
+  /// The pyramids of a cloud, built once for its alignments as frame k and as frame k-1 (the
+  /// same pointer and header stamp; a cloud changed in place needs a new stamp).
+  const detail::DirectFrame& directFrameOf(const PointCloudConstPtr& cloud);
+
   std::string class_name_ = "StaticMaskRegistration"; ///< log prefix
   Parameters params_;                                 ///< validated knobs
   CameraIntrinsics intrinsics_;                       ///< of both frames
@@ -144,6 +160,13 @@ private:
   FlowGrid source_cells_;                             ///< static cells of frame k
   FlowGrid target_cells_;                             ///< static cells of frame k-1
   Status status_ = Status::not_computed;              ///< outcome of the last align()
+  /// A cloud (and its header stamp) whose pyramids the direct backend built.
+  struct DirectEntry {
+    PointCloudConstPtr cloud;
+    std::uint64_t stamp = 0;
+    std::unique_ptr<detail::DirectFrame> frame;
+  };
+  std::array<DirectEntry, 2> direct_frames_; ///< the last two, newest first
 };
 
 } // namespace dynvo

@@ -12,13 +12,14 @@ enum class RegistrationBackend {
   flow,    ///< the trimmed flow-correspondence fit is the result (the paper's method)
   cv_rgbd, ///< OpenCV's dense RGB-D odometry (cv::rgbd::RgbdOdometry) on the static pixels
   icp,     ///< pcl::IterativeClosestPoint (point-to-point) on the static points
-  gicp ///< pcl::GeneralizedIterativeClosestPoint (plane-to-plane) on the static points
+  gicp, ///< pcl::GeneralizedIterativeClosestPoint (plane-to-plane) on the static points
+  direct ///< direct photometric alignment on the static pixels (and the keyframe fit)
 };
 
 /** \brief Parameters of StaticMaskRegistration (the single source of the defaults).
  *
  * Every backend but flow starts from the flow estimate; the icp_* fields matter for icp and
- * gicp, the rgbd_* fields for cv_rgbd.
+ * gicp, the rgbd_* fields for cv_rgbd and direct.
  */
 struct DYNVO_EXPORTS StaticMaskRegistrationParameters {
   RegistrationBackend backend = RegistrationBackend::flow; ///< the method
@@ -30,9 +31,9 @@ struct DYNVO_EXPORTS StaticMaskRegistrationParameters {
   int icp_stride =
       4; ///< (px, >= 1): ICP/GICP use every stride-th row and column of both masks (19,200 points at VGA)
   float rgbd_max_depth_difference =
-      0.07f; ///< (metres, > 0): cv_rgbd drops pixel pairs whose depths differ more (OpenCV's default)
+      0.07f; ///< (metres, > 0): cv_rgbd and direct drop pixel pairs whose depths differ more (OpenCV's default)
   float rgbd_max_depth =
-      4.0f; ///< (metres, > 0): cv_rgbd ignores farther pixels (OpenCV's default)
+      4.0f; ///< (metres, > 0): cv_rgbd and direct ignore farther pixels (OpenCV's default)
 
   /// Names, units and ranges of the fields above, in file order (ParameterTable).
   static const ParameterTable<StaticMaskRegistrationParameters>& table();

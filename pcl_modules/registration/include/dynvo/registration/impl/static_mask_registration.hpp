@@ -3,6 +3,7 @@
 #pragma once
 
 #include <dynvo/common/conventions.h>
+#include <dynvo/registration/direct_odometry.h>
 #include <dynvo/registration/rgbd_odometry.h>
 #include <dynvo/registration/rigid_refinement.h>
 #include <dynvo/registration/static_mask_registration.h>
@@ -12,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 namespace dynvo {
@@ -127,6 +129,53 @@ StaticMaskRegistration<PointT>::alignImages(const Eigen::Matrix4f& guess,
 }
 
 template <typename PointT>
+const detail::DirectFrame&
+StaticMaskRegistration<PointT>::directFrameOf(const PointCloudConstPtr& cloud)
+{
+  for (const DirectEntry& entry : direct_frames_)
+    if (entry.cloud == cloud && entry.stamp == cloud->header.stamp)
+      return *entry.frame;
+  // The older entry's buffers take the new cloud.
+  std::swap(direct_frames_[0], direct_frames_[1]);
+  DirectEntry& entry = direct_frames_[0];
+  entry.cloud = cloud;
+  entry.stamp = cloud->header.stamp;
+  auto& frame = entry.frame;
+  if (!frame)
+    frame = std::make_unique<detail::DirectFrame>();
+  frame->resize(static_cast<int>(cloud->width), static_cast<int>(cloud->height));
+  float* grey = frame->grey();
+  float* depth = frame->depth();
+  for (std::size_t i = 0; i < cloud->size(); ++i) {
+    const PointT& p = (*cloud)[i];
+    grey[i] = luma(p.r, p.g, p.b);
+    depth[i] = std::isfinite(p.z) ? p.z : std::numeric_limits<float>::quiet_NaN();
+  }
+  frame->buildPyramid();
+  return *frame;
+}
+
+template <typename PointT>
+StaticMaskRegistrationStatus
+StaticMaskRegistration<PointT>::alignDirect(const Eigen::Matrix4f& guess,
+                                            Eigen::Matrix4f& T_prev_curr)
+{
+  const auto staticPixels = [](const FlowGrid& cells) {
+    return static_cast<std::size_t>(
+               std::count(cells.labels.begin(), cells.labels.end(), LABEL_STATIC)) *
+           cells.cell_size * cells.cell_size;
+  };
+  if (!enoughPoints(staticPixels(source_cells_), staticPixels(target_cells_)))
+    return Status::too_few_points;
+  const detail::DirectFrame& source = directFrameOf(source_);
+  const detail::DirectFrame& target = directFrameOf(target_);
+  return detail::estimateDirectOdometry(source, source_cells_, target, target_cells_,
+                                        intrinsics_, params_, guess, T_prev_curr)
+             ? Status::converged
+             : Status::not_converged;
+}
+
+template <typename PointT>
 bool
 StaticMaskRegistration<PointT>::align(const Eigen::Matrix4f& guess,
                                       Eigen::Matrix4f& T_prev_curr)
@@ -141,9 +190,16 @@ StaticMaskRegistration<PointT>::align(const Eigen::Matrix4f& guess,
     return false;
   }
   Eigen::Matrix4f estimate = guess;
-  status_ = params_.backend == RegistrationBackend::cv_rgbd
-                ? alignImages(guess, estimate)
-                : alignPoints(guess, estimate);
+  switch (params_.backend) {
+  case RegistrationBackend::cv_rgbd:
+    status_ = alignImages(guess, estimate);
+    break;
+  case RegistrationBackend::direct:
+    status_ = alignDirect(guess, estimate);
+    break;
+  default:
+    status_ = alignPoints(guess, estimate);
+  }
   if (status_ == Status::converged)
     T_prev_curr = estimate;
   return status_ == Status::converged;

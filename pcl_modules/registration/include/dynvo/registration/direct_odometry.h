@@ -1,0 +1,76 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Direct photometric alignment of two frames on their static cells (docs/algorithm.md §7.4),
+// compiled once in src/direct_odometry.cpp so that OpenCV stays private (docs/style.md §2.9).
+#pragma once
+
+#include <dynvo/common/camera.h>
+#include <dynvo/common/export.h>
+#include <dynvo/common/flow_grid.h>
+#include <dynvo/registration/static_mask_registration_parameters.h>
+
+#include <Eigen/Core>
+
+#include <vector>
+
+namespace dynvo::detail {
+
+/// One frame's grey and depth pyramids (LEVELS levels, each half the size of the one below).
+class DYNVO_EXPORTS DirectFrame {
+public:
+  static constexpr int LEVELS = 3;
+
+  DirectFrame();
+  ~DirectFrame();
+
+  /// Sizes the finest level for a width x height frame (buffers are reused).
+  void resize(int width, int height);
+
+  /// The finest level's grey levels and depths (metres, NaN where none), row-major, to fill
+  /// after resize() and before buildPyramid().
+  float* grey();
+  float* depth();
+
+  /// Builds the coarser levels from the finest.
+  void buildPyramid();
+
+  DirectFrame(const DirectFrame&) = delete;
+  DirectFrame& operator=(const DirectFrame&) = delete;
+
+private:
+  struct Level;
+  std::vector<Level> levels_;
+
+  friend bool estimateDirectOdometry(const DirectFrame&,
+                                     const FlowGrid&,
+                                     const DirectFrame&,
+                                     const FlowGrid&,
+                                     const CameraIntrinsics&,
+                                     const StaticMaskRegistrationParameters&,
+                                     const Eigen::Matrix4f&,
+                                     Eigen::Matrix4f&);
+};
+
+/** \brief The camera motion from source to target that best explains the target's textured
+ * static pixels in the source image (photometric error with a brightness offset, Huber
+ * weights, inverse compositional Gauss-Newton from guess, coarse to fine; a step that raises
+ * the cost ends its level).
+ * \param[in] source frame k and its static cells
+ * \param[in] target frame k-1 and its static cells (the pixels used are the target's)
+ * \param[in] intrinsics pinhole model of both frames
+ * \param[in] parameters rgbd_max_depth (farther target pixels are not used) and
+ *            rgbd_max_depth_difference (a pixel whose source depth differs more is occluded)
+ * \param[in] guess initial T_target_source (metres)
+ * \param[out] T_target_source the estimate; written only on success
+ * \return false when a level has fewer than 100 usable pixels or the system is singular
+ */
+DYNVO_EXPORTS bool
+estimateDirectOdometry(const DirectFrame& source,
+                       const FlowGrid& source_cells,
+                       const DirectFrame& target,
+                       const FlowGrid& target_cells,
+                       const CameraIntrinsics& intrinsics,
+                       const StaticMaskRegistrationParameters& parameters,
+                       const Eigen::Matrix4f& guess,
+                       Eigen::Matrix4f& T_target_source);
+
+} // namespace dynvo::detail

@@ -1,0 +1,317 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Direct photometric alignment of two RGB-D frames on their static cells (docs/algorithm.md
+// §7.4): inverse compositional Gauss-Newton on textured target pixels, coarse to fine.
+#include <dynvo/registration/direct_odometry.h>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+#include <vector>
+
+namespace dynvo::detail {
+
+namespace {
+
+// Fixed by measurement on the real clips (src/app/NOTES.md, ninth session), not
+// configuration: they set the cost, and the estimate was insensitive to them within noise.
+/// Gauss-Newton steps per level at most.
+constexpr int MAX_ITERATIONS = 10;
+/// Samples per level at most, spread evenly.
+constexpr std::size_t BUDGET = 6000;
+/// Grey levels per pixel (central difference) a sample needs at least.
+constexpr float MIN_GRADIENT = 6.0f;
+/// The finest level is scanned on every FINE_STEP-th row and column.
+constexpr int FINE_STEP = 2;
+/// Fewer residuals on a level: the alignment fails.
+constexpr std::size_t MIN_RESIDUALS = 100;
+/// Metres and radians: a smaller step ends the level.
+constexpr float CONVERGED = 1e-5f;
+
+} // namespace
+
+struct DirectFrame::Level {
+  int width = 0;
+  int height = 0;
+  int scale = 1; ///< full-resolution pixels per pixel of this level
+  cv::Mat grey;  ///< CV_32FC1
+  cv::Mat depth; ///< CV_32FC1, NaN where none
+};
+
+DirectFrame::DirectFrame() = default;
+
+void
+DirectFrame::resize(int width, int height)
+{
+  levels_.resize(LEVELS);
+  Level& base = levels_[0];
+  base.width = width;
+  base.height = height;
+  base.grey.create(height, width, CV_32FC1);
+  base.depth.create(height, width, CV_32FC1);
+}
+
+float*
+DirectFrame::grey()
+{
+  return levels_[0].grey.ptr<float>();
+}
+
+float*
+DirectFrame::depth()
+{
+  return levels_[0].depth.ptr<float>();
+}
+
+void
+DirectFrame::buildPyramid()
+{
+  for (int l = 1; l < LEVELS; ++l) {
+    const Level& fine = levels_[l - 1];
+    Level& coarse = levels_[l];
+    cv::pyrDown(fine.grey, coarse.grey);
+    coarse.width = coarse.grey.cols;
+    coarse.height = coarse.grey.rows;
+    coarse.scale = 2 * fine.scale;
+    // Nearest depth (pixel (2x, 2y) of the finer level): no mixing across depth edges.
+    coarse.depth.create(coarse.height, coarse.width, CV_32FC1);
+    for (int y = 0; y < coarse.height; ++y) {
+      const float* in = fine.depth.ptr<float>(std::min(2 * y, fine.height - 1));
+      float* out = coarse.depth.ptr<float>(y);
+      for (int x = 0; x < coarse.width; ++x)
+        out[x] = in[std::min(2 * x, fine.width - 1)];
+    }
+  }
+}
+
+DirectFrame::~DirectFrame() = default;
+
+namespace {
+
+/// A textured target pixel: its point, intensity and the inverse compositional Jacobian.
+struct Sample {
+  Eigen::Vector3f point;
+  float intensity;
+  /// 6 pose terms, the brightness offset, then 0 (8 floats: whole SIMD registers)
+  Eigen::Matrix<float, 8, 1> jacobian;
+};
+
+/// Pinhole model of a pyramid level whose pixel (x, y) samples full-resolution (s x, s y).
+struct LevelCamera {
+  float fx, fy, cx, cy;
+  LevelCamera(const CameraIntrinsics& k, int scale)
+      : fx(static_cast<float>(k.fx / scale))
+      , fy(static_cast<float>(k.fy / scale))
+      , cx(static_cast<float>(k.cx / scale))
+      , cy(static_cast<float>(k.cy / scale))
+  {
+  }
+};
+
+/// Which pixels of a pyramid level lie in a cell labelled LABEL_STATIC: the cell of pixel
+/// (x, y) is rows[y] + cols[x], negative outside the grid.
+struct StaticLookup {
+  const FlowGrid& cells;
+  std::vector<int> rows, cols;
+  StaticLookup(const FlowGrid& grid, int width, int height, int scale)
+      : cells(grid)
+      , rows(height)
+      , cols(width)
+  {
+    const auto index = [&grid, scale](int x, std::uint32_t count, int stride) {
+      const std::uint32_t cell = static_cast<std::uint32_t>(x * scale) / grid.cell_size;
+      return cell < count ? static_cast<int>(cell) * stride : -(1 << 30);
+    };
+    for (int y = 0; y < height; ++y)
+      rows[y] = index(y, grid.rows, static_cast<int>(grid.cols));
+    for (int x = 0; x < width; ++x)
+      cols[x] = index(x, grid.cols, 1);
+  }
+  bool operator()(int x, int y) const
+  {
+    const int cell = rows[y] + cols[x];
+    return cell >= 0 && cells.labels[cell] == LABEL_STATIC;
+  }
+};
+
+template <typename Level>
+std::vector<Sample>
+samplesOf(const Level& level,
+          const StaticLookup& isStatic,
+          const LevelCamera& camera,
+          float max_depth)
+{
+  // The textured static pixels with depth, then at most BUDGET of them evenly spread.
+  std::vector<std::pair<int, int>> pixels;
+  const int step = level.scale == 1 ? FINE_STEP : 1;
+  for (int y = 1; y + 1 < level.height; y += step) {
+    const float* row = level.grey.template ptr<float>(y);
+    const float* up = level.grey.template ptr<float>(y - 1);
+    const float* down = level.grey.template ptr<float>(y + 1);
+    const float* depth = level.depth.template ptr<float>(y);
+    for (int x = 1; x + 1 < level.width; x += step) {
+      const float z = depth[x];
+      if (!(z > 0.0f && z <= max_depth))
+        continue;
+      const float gx = row[x + 1] - row[x - 1];
+      const float gy = down[x] - up[x];
+      if (gx * gx + gy * gy >= 4.0f * MIN_GRADIENT * MIN_GRADIENT && isStatic(x, y))
+        pixels.emplace_back(x, y);
+    }
+  }
+  const std::size_t count = std::min(pixels.size(), BUDGET);
+  const double stride = count > 0 ? static_cast<double>(pixels.size()) / count : 0.0;
+  std::vector<Sample> samples(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    const auto [x, y] = pixels[static_cast<std::size_t>(i * stride)];
+    const float* row = level.grey.template ptr<float>(y);
+    const float gx = 0.5f * (row[x + 1] - row[x - 1]);
+    const float gy = 0.5f * (level.grey.template ptr<float>(y + 1)[x] -
+                             level.grey.template ptr<float>(y - 1)[x]);
+    const float z = level.depth.template ptr<float>(y)[x];
+    Sample& s = samples[i];
+    s.point = Eigen::Vector3f((x - camera.cx) * z / camera.fx,
+                              (y - camera.cy) * z / camera.fy, z);
+    s.intensity = row[x];
+    const float X = s.point.x(), Y = s.point.y(), iz = 1.0f / z;
+    // d(intensity)/d(point) through the projection, then d(point)/d(twist) = [I | -[P]x].
+    const Eigen::Vector3f dI_dP(gx * camera.fx * iz, gy * camera.fy * iz,
+                                -(gx * camera.fx * X + gy * camera.fy * Y) * iz * iz);
+    s.jacobian.head<3>() = dI_dP;
+    s.jacobian.segment<3>(3) = s.point.cross(dI_dP);
+    s.jacobian[6] = 1.0f;
+    s.jacobian[7] = 0.0f;
+  }
+  return samples;
+}
+
+float
+bilinear(const cv::Mat& image, float u, float v)
+{
+  const int x = static_cast<int>(u), y = static_cast<int>(v);
+  const float a = u - x, b = v - y;
+  const float* r0 = image.ptr<float>(y) + x;
+  const float* r1 = image.ptr<float>(y + 1) + x;
+  return (1 - b) * ((1 - a) * r0[0] + a * r0[1]) + b * ((1 - a) * r1[0] + a * r1[1]);
+}
+
+} // namespace
+
+bool
+estimateDirectOdometry(const DirectFrame& source,
+                       const FlowGrid& source_cells,
+                       const DirectFrame& target,
+                       const FlowGrid& target_cells,
+                       const CameraIntrinsics& intrinsics,
+                       const StaticMaskRegistrationParameters& parameters,
+                       const Eigen::Matrix4f& guess,
+                       Eigen::Matrix4f& T_target_source)
+{
+  Eigen::Isometry3f T(Eigen::Isometry3f(guess).inverse()); // T_source_target
+  float offset = 0.0f;
+  std::vector<float> residuals; // magnitudes, for the Huber threshold
+  for (int l = DirectFrame::LEVELS - 1; l >= 0; --l) {
+    const DirectFrame::Level& s = source.levels_[l];
+    const LevelCamera camera(intrinsics, s.scale);
+    const DirectFrame::Level& t = target.levels_[l];
+    const std::vector<Sample> samples =
+        samplesOf(t, StaticLookup(target_cells, t.width, t.height, t.scale), camera,
+                  parameters.rgbd_max_depth);
+    const StaticLookup isStatic(source_cells, s.width, s.height, s.scale);
+    float k = 0.0f; // Huber threshold of this level, from the first residuals' spread
+    double last_cost = std::numeric_limits<double>::infinity();
+    Eigen::Isometry3f last_T = T;
+    float last_offset = offset;
+    for (int iteration = 0; iteration <= MAX_ITERATIONS; ++iteration) {
+      const Eigen::Matrix3f R = T.linear();
+      const Eigen::Vector3f t = T.translation();
+      // The residual of a sample under T, NaN when it has none (off the image, not static,
+      // occluded).
+      const auto residualOf = [&](const Sample& sample) {
+        const float none = std::numeric_limits<float>::quiet_NaN();
+        const Eigen::Vector3f q = R * sample.point + t;
+        if (!(q.z() > 0.0f))
+          return none;
+        const float u = camera.fx * q.x() / q.z() + camera.cx;
+        const float v = camera.fy * q.y() / q.z() + camera.cy;
+        if (!(u >= 0.0f && v >= 0.0f && u < s.width - 1 && v < s.height - 1))
+          return none;
+        const int nx = static_cast<int>(u + 0.5f), ny = static_cast<int>(v + 0.5f);
+        if (!isStatic(nx, ny))
+          return none;
+        const float zs = s.depth.ptr<float>(ny)[nx];
+        if (std::abs(zs - q.z()) > parameters.rgbd_max_depth_difference)
+          return none;
+        return bilinear(s.grey, u, v) - sample.intensity - offset;
+      };
+      if (iteration == 0) { // Huber's threshold of the level: 1.345 robust sigmas
+        residuals.clear();
+        for (const Sample& sample : samples) {
+          const float r = residualOf(sample);
+          if (!std::isnan(r))
+            residuals.push_back(std::abs(r));
+        }
+        if (residuals.size() < MIN_RESIDUALS)
+          return false;
+        const auto middle = residuals.begin() + residuals.size() / 2;
+        std::nth_element(residuals.begin(), middle, residuals.end());
+        k = 1.345f * std::max(1.4826f * *middle, 1.0f);
+      }
+      Eigen::Matrix<float, 8, 8> H = Eigen::Matrix<float, 8, 8>::Zero();
+      Eigen::Matrix<float, 8, 1> g = Eigen::Matrix<float, 8, 1>::Zero();
+      double cost = 0.0;
+      std::size_t count = 0;
+      for (const Sample& sample : samples) {
+        const float r = residualOf(sample);
+        if (std::isnan(r))
+          continue;
+        const float a = std::abs(r);
+        const float w = a <= k ? 1.0f : k / a;
+        cost += a <= k ? 0.5 * r * r : k * (a - 0.5 * k);
+        H.noalias() += (w * sample.jacobian) * sample.jacobian.transpose();
+        g.noalias() += (w * r) * sample.jacobian;
+        ++count;
+      }
+      if (count < MIN_RESIDUALS)
+        return false;
+      cost /= static_cast<double>(count);
+      if (!(cost < last_cost)) { // the last step went uphill: take the pose before it
+        T = last_T;
+        offset = last_offset;
+        break;
+      }
+      last_cost = cost;
+      last_T = T;
+      last_offset = offset;
+      if (iteration == MAX_ITERATIONS)
+        break;
+      const Eigen::Matrix<double, 7, 1> delta =
+          H.topLeftCorner<7, 7>().cast<double>().ldlt().solve(
+              g.head<7>().cast<double>());
+      if (!delta.allFinite())
+        return false;
+      const Eigen::Vector3f v = delta.head<3>().cast<float>();
+      const Eigen::Vector3f w = delta.segment<3>(3).cast<float>();
+      Eigen::Isometry3f step = Eigen::Isometry3f::Identity();
+      const float angle = w.norm();
+      if (angle > 0.0f)
+        step.linear() = Eigen::AngleAxisf(angle, w / angle).toRotationMatrix();
+      step.translation() = v;
+      T = T * step.inverse();
+      offset += static_cast<float>(delta[6]);
+      if (v.norm() < CONVERGED && angle < CONVERGED)
+        break;
+    }
+  }
+  if (!T.matrix().allFinite())
+    return false;
+  T_target_source = T.inverse().matrix();
+  return true;
+}
+
+} // namespace dynvo::detail
