@@ -71,6 +71,7 @@ DirectFrame::depth()
 void
 DirectFrame::buildPyramid()
 {
+  samples_.reset();
   for (int l = 1; l < LEVELS; ++l) {
     const Level& fine = levels_[l - 1];
     Level& coarse = levels_[l];
@@ -202,6 +203,38 @@ bilinear(const cv::Mat& image, float u, float v)
 
 } // namespace
 
+struct DirectFrame::SampleCache {
+  FlowGrid cells;
+  CameraIntrinsics intrinsics;
+  float max_depth = 0.0f;
+  std::vector<std::vector<Sample>> levels;
+};
+
+const DirectFrame::SampleCache&
+DirectFrame::samples(const FlowGrid& cells,
+                     const CameraIntrinsics& intrinsics,
+                     float max_depth) const
+{
+  const auto same = [&](const SampleCache& c) {
+    return c.cells.cell_size == cells.cell_size && c.cells.labels == cells.labels &&
+           c.intrinsics.fx == intrinsics.fx && c.intrinsics.fy == intrinsics.fy &&
+           c.intrinsics.cx == intrinsics.cx && c.intrinsics.cy == intrinsics.cy &&
+           c.max_depth == max_depth;
+  };
+  if (samples_ && same(*samples_))
+    return *samples_;
+  auto cache = std::make_unique<SampleCache>();
+  cache->cells = cells;
+  cache->intrinsics = intrinsics;
+  cache->max_depth = max_depth;
+  for (const Level& level : levels_)
+    cache->levels.push_back(
+        samplesOf(level, StaticLookup(cells, level.width, level.height, level.scale),
+                  LevelCamera(intrinsics, level.scale), max_depth));
+  samples_ = std::move(cache);
+  return *samples_;
+}
+
 bool
 estimateDirectOdometry(const DirectFrame& source,
                        const FlowGrid& source_cells,
@@ -215,13 +248,12 @@ estimateDirectOdometry(const DirectFrame& source,
   Eigen::Isometry3f T(Eigen::Isometry3f(guess).inverse()); // T_source_target
   float offset = 0.0f;
   std::vector<float> residuals; // magnitudes, for the Huber threshold
+  const DirectFrame::SampleCache& target_samples =
+      target.samples(target_cells, intrinsics, parameters.rgbd_max_depth);
   for (int l = DirectFrame::LEVELS - 1; l >= 0; --l) {
     const DirectFrame::Level& s = source.levels_[l];
     const LevelCamera camera(intrinsics, s.scale);
-    const DirectFrame::Level& t = target.levels_[l];
-    const std::vector<Sample> samples =
-        samplesOf(t, StaticLookup(target_cells, t.width, t.height, t.scale), camera,
-                  parameters.rgbd_max_depth);
+    const std::vector<Sample>& samples = target_samples.levels[l];
     const StaticLookup isStatic(source_cells, s.width, s.height, s.scale);
     float k = 0.0f; // Huber threshold of this level, from the first residuals' spread
     double last_cost = std::numeric_limits<double>::infinity();

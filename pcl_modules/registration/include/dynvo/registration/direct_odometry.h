@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 
+#include <memory>
 #include <vector>
 
 namespace dynvo::detail {
@@ -38,7 +39,17 @@ public:
 
 private:
   struct Level;
+  struct SampleCache;
+
+  /// The samples of this frame as the target of an alignment, per level: chosen once for a
+  /// given mask, camera and depth limit (the step and its refit share them).
+  const SampleCache& samples(const FlowGrid& cells,
+                             const CameraIntrinsics& intrinsics,
+                             float max_depth) const;
+
   std::vector<Level> levels_;
+  /// empty until samples(), reset by buildPyramid()
+  mutable std::unique_ptr<SampleCache> samples_;
 
   friend bool estimateDirectOdometry(const DirectFrame&,
                                      const FlowGrid&,

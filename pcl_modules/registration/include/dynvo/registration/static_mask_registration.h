@@ -108,8 +108,14 @@ public:
 
   const CameraIntrinsics& getCameraIntrinsics() const { return intrinsics_; }
 
-  /// Frame k (organized, metres).
-  void setInputSource(const PointCloudConstPtr& cloud) { source_ = cloud; }
+  /// Frame k (organized, metres). With the direct backend its pyramids are built here, once
+  /// per cloud (set it while the cloud is still in the cache).
+  void setInputSource(const PointCloudConstPtr& cloud)
+  {
+    source_ = cloud;
+    if (cloud && params_.backend == RegistrationBackend::direct)
+      directFrameOf(cloud);
+  }
 
   /// Frame k-1 (organized, metres, the source's size).
   void setInputTarget(const PointCloudConstPtr& cloud) { target_ = cloud; }
