@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Direct photometric alignment of two RGB-D frames on their static cells (docs/algorithm.md
-// §7.4): inverse compositional Gauss-Newton on textured target pixels, coarse to fine.
+// §7.7): inverse compositional Gauss-Newton on textured target pixels, coarse to fine.
 #include <dynvo/registration/direct_odometry.h>
 
 #include <opencv2/core.hpp>

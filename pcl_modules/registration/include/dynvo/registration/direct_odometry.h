@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Direct photometric alignment of two frames on their static cells (docs/algorithm.md §7.4),
+// Direct photometric alignment of two frames on their static cells (docs/algorithm.md §7.7),
 // compiled once in src/direct_odometry.cpp so that OpenCV stays private (docs/style.md §2.9).
 #pragma once
 
