@@ -155,8 +155,10 @@ private:
   Status alignDirect(const Eigen::Matrix4f& guess, Eigen::Matrix4f& T_prev_curr);
 
   /// The pyramids of a cloud, built once for its alignments as frame k and as frame k-1 (the
-  /// same pointer and header stamp; a cloud changed in place needs a new stamp).
-  const detail::DirectFrame& directFrameOf(const PointCloudConstPtr& cloud);
+  /// same pointer and header stamp; a cloud changed in place needs a new stamp); in_use is
+  /// not evicted.
+  const detail::DirectFrame& directFrameOf(const PointCloudConstPtr& cloud,
+                                           const detail::DirectFrame* in_use = nullptr);
 
   std::string class_name_ = "StaticMaskRegistration"; ///< log prefix
   Parameters params_;                                 ///< validated knobs

@@ -130,13 +130,16 @@ StaticMaskRegistration<PointT>::alignImages(const Eigen::Matrix4f& guess,
 
 template <typename PointT>
 const detail::DirectFrame&
-StaticMaskRegistration<PointT>::directFrameOf(const PointCloudConstPtr& cloud)
+StaticMaskRegistration<PointT>::directFrameOf(const PointCloudConstPtr& cloud,
+                                              const detail::DirectFrame* in_use)
 {
   for (const DirectEntry& entry : direct_frames_)
     if (entry.cloud == cloud && entry.stamp == cloud->header.stamp)
       return *entry.frame;
-  // The older entry's buffers take the new cloud.
-  std::swap(direct_frames_[0], direct_frames_[1]);
+  // The older entry's buffers take the new cloud, unless they hold the frame in use.
+  const std::size_t reused =
+      direct_frames_[1].frame && direct_frames_[1].frame.get() == in_use ? 0 : 1;
+  std::swap(direct_frames_[0], direct_frames_[reused]);
   DirectEntry& entry = direct_frames_[0];
   entry.cloud = cloud;
   entry.stamp = cloud->header.stamp;
@@ -168,7 +171,7 @@ StaticMaskRegistration<PointT>::alignDirect(const Eigen::Matrix4f& guess,
   if (!enoughPoints(staticPixels(source_cells_), staticPixels(target_cells_)))
     return Status::too_few_points;
   const detail::DirectFrame& source = directFrameOf(source_);
-  const detail::DirectFrame& target = directFrameOf(target_);
+  const detail::DirectFrame& target = directFrameOf(target_, &source);
   return detail::estimateDirectOdometry(source, source_cells_, target, target_cells_,
                                         intrinsics_, params_, guess, T_prev_curr)
              ? Status::converged
