@@ -431,7 +431,7 @@ struct OdometryPipeline::Impl {
         history.begin() + static_cast<std::ptrdiff_t>(history.size() / 2);
     std::nth_element(history.begin(), middle, history.end());
     // The direct step's refit keeps a slow mover out of the chain by itself (docs/algorithm.md
-    // §7.3): the test is the flow backend's.
+    // §7.7): the test is the flow backend's.
     const bool apart = options.backend.backend == RegistrationBackend::flow &&
                        history.size() >= MIN_DEPARTURES && departure > 3.0 * *middle;
     departures.push_back(departure);
