@@ -232,7 +232,7 @@ TYPED_TEST(GridSceneFlowTest, KeyframeFlowStartsFromThePredictionAndOutlivesLate
 {
   const auto scene = staticRoom();
   // Keyframe a, then b and c: c is 9 cm and 5 deg from a, 10-16 px of flow at this size,
-  // beyond what LK on the finest level finds from c_i alone (a 13 px window).
+  // beyond what LK on the finest level finds from c_i alone (a 16 px window).
   const Eigen::Isometry3d T_world_a = Eigen::Isometry3d::Identity();
   const Eigen::Isometry3d T_world_b = pose(0.5, 2.0, 0.3, 0.03, -0.01, 0.02);
   const Eigen::Isometry3d T_world_c = pose(1.0, 5.0, 0.6, 0.08, -0.02, 0.04);

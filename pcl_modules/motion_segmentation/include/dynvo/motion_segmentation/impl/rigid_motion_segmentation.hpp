@@ -10,9 +10,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstddef>
+#include <numeric>
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <utility>
 
 namespace dynvo {
 
@@ -163,19 +166,34 @@ RigidMotionSegmentation<PointT>::computeImplIndices(
       stripes, std::vector<std::vector<int>>(segment_labels_.size()));
   const auto extract = [&](int stripe) {
     std::vector<std::vector<int>>& out = parts[stripe];
-    const int first = height * stripe / stripes, end = height * (stripe + 1) / stripes;
+    const int first = width * (height * stripe / stripes);
+    const int end = width * (height * (stripe + 1) / stripes);
+    // Runs of one label (most of a row is one segment): counted, then written as ranges.
+    struct Run {
+      int begin, end, segment;
+    };
+    std::vector<Run> runs;
     std::vector<std::size_t> size(out.size(), 0);
-    for (int index = first * width; index < end * width; ++index) {
-      const int s = slot[pixel_labels_[index]];
-      if (s >= 0)
-        ++size[s];
+    for (int index = first; index < end;) {
+      const std::uint8_t label = pixel_labels_[index];
+      int run_end = index + 1;
+      while (run_end < end && pixel_labels_[run_end] == label)
+        ++run_end;
+      const int s = slot[label];
+      if (s >= 0) {
+        runs.push_back({index, run_end, s});
+        size[s] += static_cast<std::size_t>(run_end - index);
+      }
+      index = run_end;
     }
     for (std::size_t s = 0; s < out.size(); ++s)
       out[s].reserve(size[s]);
-    for (int index = first * width; index < end * width; ++index) {
-      const int s = slot[pixel_labels_[index]];
-      if (s >= 0)
-        out[s].push_back(index);
+    for (const Run& run : runs) {
+      std::vector<int>& indices = out[run.segment];
+      const std::size_t old = indices.size();
+      indices.resize(old + static_cast<std::size_t>(run.end - run.begin));
+      std::iota(indices.begin() + static_cast<std::ptrdiff_t>(old), indices.end(),
+                run.begin);
     }
   };
   std::vector<std::thread> workers;
@@ -187,9 +205,10 @@ RigidMotionSegmentation<PointT>::computeImplIndices(
   segments.assign(segment_labels_.size(), pcl::PointIndices());
   for (std::size_t s = 0; s < segments.size(); ++s) {
     segments[s].header = input_->header;
-    for (const auto& part : parts)
-      segments[s].indices.insert(segments[s].indices.end(), part[s].begin(),
-                                 part[s].end());
+    segments[s].indices = std::move(parts[0][s]);
+    for (int stripe = 1; stripe < stripes; ++stripe)
+      segments[s].indices.insert(segments[s].indices.end(), parts[stripe][s].begin(),
+                                 parts[stripe][s].end());
   }
 }
 
