@@ -221,6 +221,7 @@ struct OdometryPipeline::Impl {
       result.inlier_threshold = noise_tracker.getInlierThreshold();
       segmentation.setInlierThreshold(static_cast<float>(result.inlier_threshold));
       segmentation.setInputCloud(cloud);
+      segmentation.setInputDepth(flow_estimation.getInputDepth());
       segmentation.setInputFlow(flow);
       segmentation.setPredictedMotion(T_curr_prev_predicted.cast<float>());
       segmentation.segmentCells();

@@ -177,7 +177,8 @@ BM_PixelLabelRefinement(benchmark::State& state)
   for (auto _ : state) {
     const std::size_t f = k++ % frames.size();
     const pcl::PointCloud<Point>& cloud = *frames[f].cloud;
-    refinement.refine(cells[f], model[f], &cloud[0].z, &cloud[0].rgba, stride, pixels);
+    refinement.refine(cells[f], model[f], &cloud[0].z, stride, &cloud[0].rgba, stride,
+                      pixels);
     benchmark::DoNotOptimize(pixels.data());
   }
 }

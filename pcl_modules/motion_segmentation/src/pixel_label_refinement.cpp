@@ -60,8 +60,9 @@ PixelLabelRefinement::continuous(float z_a, float z_b) const
 void
 PixelLabelRefinement::computeCellDepths(const FlowGrid& cells,
                                         const float* depth,
+                                        std::size_t depth_stride,
                                         const std::uint32_t* rgba,
-                                        std::size_t stride)
+                                        std::size_t rgba_stride)
 {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const std::size_t width = cells.image_width;
@@ -71,8 +72,8 @@ PixelLabelRefinement::computeCellDepths(const FlowGrid& cells,
   for (std::size_t i = 0; i < cells.size(); ++i) {
     const std::size_t centre = cells.centreIndex(i);
     if (rgba)
-      cell_grey_[i] = greyOf(rgba[centre * stride]);
-    const float z = depth[centre * stride];
+      cell_grey_[i] = greyOf(rgba[centre * rgba_stride]);
+    const float z = depth[centre * depth_stride];
     if (hasDepth(z)) {
       cell_depth_[i] = z;
       continue;
@@ -89,7 +90,7 @@ PixelLabelRefinement::computeCellDepths(const FlowGrid& cells,
       std::size_t count = 0;
       for (std::size_t v = v0; v < v0 + n && v < top + cell; ++v)
         for (std::size_t u = u0; u < u0 + n && u < left + cell; ++u) {
-          const float zp = depth[(v * width + u) * stride];
+          const float zp = depth[(v * width + u) * depth_stride];
           if (hasDepth(zp)) {
             sum += zp;
             ++count;
@@ -199,8 +200,9 @@ void
 PixelLabelRefinement::refine(const FlowGrid& cells,
                              const std::vector<std::uint8_t>& fallback_labels,
                              const float* depth,
+                             std::size_t depth_stride,
                              const std::uint32_t* rgba,
-                             std::size_t stride,
+                             std::size_t rgba_stride,
                              std::vector<std::uint8_t>& pixel_labels)
 {
   if (!fallback_labels.empty() && fallback_labels.size() != cells.size())
@@ -213,7 +215,7 @@ PixelLabelRefinement::refine(const FlowGrid& cells,
   pixel_labels.assign(width * height, LABEL_NONE);
   if (cells.size() == 0 || !depth)
     return;
-  computeCellDepths(cells, depth, rgba, stride);
+  computeCellDepths(cells, depth, depth_stride, rgba, rgba_stride);
   fillCells(cells, fallback_labels);
   computeGradients(cells);
 
@@ -264,7 +266,7 @@ PixelLabelRefinement::refine(const FlowGrid& cells,
         for (int v = v0; v < v1; ++v) {
           const std::size_t first = static_cast<std::size_t>(v) * width;
           for (int u = u0; u < u1; ++u)
-            if (hasDepth(depth[(first + u) * stride]))
+            if (hasDepth(depth[(first + u) * depth_stride]))
               pixel_labels[first + u] = label;
         }
         continue;
@@ -272,10 +274,10 @@ PixelLabelRefinement::refine(const FlowGrid& cells,
       for (int v = v0; v < v1; ++v)
         for (int u = u0; u < u1; ++u) {
           const std::size_t p = static_cast<std::size_t>(v) * width + u;
-          const float z = depth[p * stride];
+          const float z = depth[p * depth_stride];
           if (!hasDepth(z))
             continue;
-          const float grey = rgba ? greyOf(rgba[p * stride]) : 0.0f;
+          const float grey = rgba ? greyOf(rgba[p * rgba_stride]) : 0.0f;
           const float inv_z2 = inv_tol2 / (z * z);
           const float fu = static_cast<float>(u), fv = static_cast<float>(v);
           float best = std::numeric_limits<float>::infinity();

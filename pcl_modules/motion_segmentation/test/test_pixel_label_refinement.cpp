@@ -50,10 +50,10 @@ TEST(PixelLabelRefinementContract, BadParametersAndFallbackSizeThrow)
   DepthGrid grid;
   std::vector<std::uint8_t> pixels;
   EXPECT_THROW(refinement.refine(grid.cells, std::vector<std::uint8_t>(3, 1),
-                                 grid.depth.data(), nullptr, 1, pixels),
+                                 grid.depth.data(), 1, nullptr, 1, pixels),
                std::invalid_argument);
   // No labelled cell at all: nothing to spread, every pixel stays 0.
-  refinement.refine(grid.cells, {}, grid.depth.data(), nullptr, 1, pixels);
+  refinement.refine(grid.cells, {}, grid.depth.data(), 1, nullptr, 1, pixels);
   ASSERT_EQ(pixels.size(), std::size_t{W} * H);
   EXPECT_EQ(std::count(pixels.begin(), pixels.end(), 0), static_cast<long>(W * H));
 }
@@ -83,13 +83,13 @@ TEST(PixelLabelRefinement, UnlabelledCellsTakeDepthContinuousNeighboursThenTheMo
 
   dynvo::PixelLabelRefinement refinement;
   std::vector<std::uint8_t> pixels;
-  refinement.refine(grid.cells, model, grid.depth.data(), nullptr, 1, pixels);
+  refinement.refine(grid.cells, model, grid.depth.data(), 1, nullptr, 1, pixels);
   const std::vector<std::uint8_t>& filled = refinement.getFilledCellLabels();
   EXPECT_EQ(filled[a], dynvo::LABEL_STATIC);
   EXPECT_EQ(filled[b], 3);
   EXPECT_EQ(filled[c], 3);
   // Without the model, B (discontinuous everywhere) takes its closest-depth neighbour.
-  refinement.refine(grid.cells, {}, grid.depth.data(), nullptr, 1, pixels);
+  refinement.refine(grid.cells, {}, grid.depth.data(), 1, nullptr, 1, pixels);
   EXPECT_EQ(refinement.getFilledCellLabels()[b], 3);
   // Label 0 exactly where the depth is missing.
   for (std::size_t p = 0; p < pixels.size(); ++p)

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <vector>
@@ -89,12 +90,21 @@ TYPED_TEST(RigidMotionSegmentationTyped, SameFrameTwiceGivesOneStaticSegment)
   EXPECT_TRUE(segmentation.getMotions()[0].isIdentity(1e-5f));
 }
 
+/// A static camera and one object turning 0.04 rad and moving (2, 0, 3) cm (cells 20-32 x 5-15
+/// at 1.1 m), 2 mm of noise per axis.
+const Eigen::Matrix4d T_OBJECT = makeMotion({0, 1, 1}, 0.04, {0.02, 0.0, 0.03});
+
+dynvo::test::SyntheticFlow
+objectFlow()
+{
+  return dynvo::test::makeSyntheticFlow(40, 30, CELL, dynvo::test::intrinsicsFor(160),
+                                        Eigen::Matrix4d::Identity(),
+                                        {{20, 5, 32, 15, 1.1, T_OBJECT, 2}}, 0.002, 9);
+}
+
 TEST(RigidMotionSegmentationDeterminism, SameSeedSameOutputForOneAndTwoThreads)
 {
-  const Eigen::Matrix4d T_object = makeMotion({0, 1, 1}, 0.04, {0.02, 0.0, 0.03});
-  const auto synthetic = dynvo::test::makeSyntheticFlow(
-      40, 30, CELL, dynvo::test::intrinsicsFor(160), Eigen::Matrix4d::Identity(),
-      {{20, 5, 32, 15, 1.1, T_object, 2}}, 0.002, 9);
+  const auto synthetic = objectFlow();
   const auto cloud =
       dynvo::test::cloudFromFlow<pcl::PointXYZRGB>(*synthetic.flow, CELL);
   const auto run = [&](unsigned threads) {
@@ -116,7 +126,7 @@ TEST(RigidMotionSegmentationDeterminism, SameSeedSameOutputForOneAndTwoThreads)
   for (const pcl::PointIndices& segment : one.first)
     EXPECT_FALSE(segment.indices.empty());
   EXPECT_TRUE(std::any_of(one.second.begin() + 1, one.second.end(), [&](const auto& H) {
-    return dynvo::test::translationError(H, T_object) < 0.01; // 2 mm noise per axis
+    return dynvo::test::translationError(H, T_OBJECT) < 0.01; // 2 mm noise per axis
   }));
   ASSERT_EQ(one.first.size(), two.first.size());
   ASSERT_EQ(one.second.size(), two.second.size());
@@ -124,6 +134,44 @@ TEST(RigidMotionSegmentationDeterminism, SameSeedSameOutputForOneAndTwoThreads)
     EXPECT_EQ(one.first[s].indices, two.first[s].indices);
   for (std::size_t s = 0; s < one.second.size(); ++s)
     EXPECT_TRUE(one.second[s] == two.second[s]); // bit-identical
+}
+
+TEST(RigidMotionSegmentationContract, DepthImageGivesTheLabelsOfTheCloud)
+{
+  const auto synthetic = objectFlow();
+  const auto cloud =
+      dynvo::test::cloudFromFlow<pcl::PointXYZRGB>(*synthetic.flow, CELL);
+  std::vector<float> depth;
+  for (const auto& point : *cloud)
+    depth.push_back(std::isfinite(point.z) ? point.z
+                                           : std::numeric_limits<float>::quiet_NaN());
+  // Each run on a new object: same seed, same cell stage, only the pixels' source differs.
+  const auto run = [&](const std::vector<float>* image, bool before_cloud = false) {
+    dynvo::RigidMotionSegmentation<pcl::PointXYZRGB> segmentation;
+    segmentation.setSeed(7);
+    if (image && before_cloud)
+      segmentation.setInputDepth(*image);
+    segmentation.setInputCloud(cloud);
+    if (image && !before_cloud)
+      segmentation.setInputDepth(*image);
+    segmentation.setInputFlow(synthetic.flow);
+    std::vector<pcl::PointIndices> segments;
+    segmentation.segment(segments);
+    return std::make_pair(segmentation.getPixelLabels(), segments.size());
+  };
+  const auto from_cloud = run(nullptr);
+  // Not vacuous: background and object, so boundary cells compare per-pixel depths.
+  ASSERT_GE(from_cloud.second, 2u);
+  EXPECT_EQ(run(&depth), from_cloud);
+  // The image is what is read: without depth no pixel gets a label.
+  const std::vector<float> none(depth.size(), std::numeric_limits<float>::quiet_NaN());
+  const auto from_none = run(&none);
+  EXPECT_EQ(std::count(from_none.first.begin(), from_none.first.end(), 0),
+            static_cast<long>(none.size()));
+  // An image of another size is ignored, and setInputCloud() drops the image set before it.
+  const std::vector<float> short_by_one(depth.begin(), depth.end() - 1);
+  EXPECT_EQ(run(&short_by_one), from_cloud);
+  EXPECT_EQ(run(&none, true), from_cloud);
 }
 
 TEST(RigidMotionSegmentationContract, BadInputsClearOutputs)

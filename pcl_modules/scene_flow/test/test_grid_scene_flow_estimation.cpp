@@ -392,6 +392,35 @@ TYPED_TEST(GridSceneFlowTest, ShiftCurrentToPreviousMatchesAFreshComputation)
   EXPECT_TRUE(identical(this->flow_, expected));
 }
 
+TYPED_TEST(GridSceneFlowTest, InputDepthIsTheZOfTheInputCloud)
+{
+  const auto scene = staticRoom();
+  const auto f0 = this->view(scene, Eigen::Isometry3d::Identity());
+  const auto f1 = this->view(scene, pose(0, 0.4, 0, 0.01, 0, 0));
+  const auto f2 = this->view(scene, pose(0, 0.8, 0, 0.02, 0.005, 0));
+  // z of every point, NaN where it has none; the views differ, so a mix-up shows.
+  const auto matches = [](const std::vector<float>& depth, const auto& cloud) {
+    if (depth.size() != cloud.size())
+      return false;
+    for (std::size_t i = 0; i < depth.size(); ++i)
+      if (!(depth[i] == cloud[i].z ||
+            (std::isnan(depth[i]) && !std::isfinite(cloud[i].z))))
+        return false;
+    return true;
+  };
+  ASSERT_FALSE(matches(std::vector<float>(f1.cloud->size()), *f1.cloud));
+  auto& estimation = this->estimation_;
+  // The first pair prepares the previous cloud too: the depth stays the input's.
+  this->run(f0.cloud, f1.cloud);
+  EXPECT_TRUE(matches(estimation.getInputDepth(), *f1.cloud));
+  estimation.shiftCurrentToPrevious();
+  EXPECT_TRUE(estimation.getInputDepth().empty());
+  estimation.setInputCloud(f2.cloud);
+  EXPECT_TRUE(estimation.getInputDepth().empty()); // not read before compute()
+  estimation.compute(this->flow_);
+  EXPECT_TRUE(matches(estimation.getInputDepth(), *f2.cloud));
+}
+
 /// The camera of a steady sweep at t seconds: 60 deg/s about y, 0.3 m/s sideways and
 /// 0.4 m/s forward (a fast hand-held motion).
 Eigen::Isometry3d

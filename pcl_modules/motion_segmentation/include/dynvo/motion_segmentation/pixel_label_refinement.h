@@ -41,8 +41,8 @@ namespace dynvo {
  * dynvo::PixelLabelRefinement refinement;
  * std::vector<std::uint8_t> pixel_labels;
  * const std::size_t stride = sizeof(PointT) / sizeof(float);
- * refinement.refine(cell_grid, model_labels, &(*cloud)[0].z, &(*cloud)[0].rgba, stride,
- *                   pixel_labels);
+ * refinement.refine(cell_grid, model_labels, &(*cloud)[0].z, stride, &(*cloud)[0].rgba,
+ *                   stride, pixel_labels);
  * \endcode
  */
 class DYNVO_EXPORTS PixelLabelRefinement {
@@ -74,18 +74,21 @@ public:
    *            depth-continuous labelled neighbour takes (the dual model's read-out); empty =
    *            none
    * \param[in] depth z of pixel 0 (metres; NaN or <= 0 = no depth); pixel i's z is
-   *            depth[i * stride]
+   *            depth[i * depth_stride]
+   * \param[in] depth_stride floats from one pixel's z to the next (1 for a depth image,
+   *            sizeof(PointT) / 4 for a cloud's points)
    * \param[in] rgba packed colour of pixel 0 (PCL's rgba: b, g, r, a bytes), pixel i's at
-   *            rgba[i * stride]; null to ignore colour
-   * \param[in] stride 4-byte words from one pixel to the next (sizeof(PointT) / 4)
+   *            rgba[i * rgba_stride]; null to ignore colour
+   * \param[in] rgba_stride 4-byte words from one pixel's colour to the next
    * \param[out] pixel_labels one label per pixel (row * width + col), 0 without depth
    * \throws std::invalid_argument when fallback_labels is neither empty nor one per cell
    */
   void refine(const FlowGrid& cells,
               const std::vector<std::uint8_t>& fallback_labels,
               const float* depth,
+              std::size_t depth_stride,
               const std::uint32_t* rgba,
-              std::size_t stride,
+              std::size_t rgba_stride,
               std::vector<std::uint8_t>& pixel_labels);
 
   /// The cell labels after step 1 of the last refine().
@@ -95,8 +98,9 @@ private:
   /// Reference depth, grey level and depth gradient of every cell (step 1's inputs).
   void computeCellDepths(const FlowGrid& cells,
                          const float* depth,
+                         std::size_t depth_stride,
                          const std::uint32_t* rgba,
-                         std::size_t stride);
+                         std::size_t rgba_stride);
 
   /// Step 1 on filled_.
   void fillCells(const FlowGrid& cells,

@@ -79,8 +79,17 @@ public:
   /// Name used in log prefixes: "RigidMotionSegmentation".
   const std::string& getClassName() const { return class_name_; }
 
-  /// Current frame k (organized, metres); the pixel indices of segment() refer to it.
+  /// Current frame k (organized, metres); the pixel indices of segment() refer to it. Clears
+  /// the depth image of setInputDepth().
   void setInputCloud(const PointCloudConstPtr& cloud) override;
+
+  /** \brief The input cloud's z as a row-major image (metres, NaN where the point has none),
+   * such as GridSceneFlowEstimation::getInputDepth() after its compute() on the same cloud.
+   * Optional: the pixel labels read it instead of the cloud's points (the same labels; the
+   * points are 8 times larger than their z). Call it after setInputCloud(); ignored unless it
+   * holds one value per point.
+   */
+  void setInputDepth(const std::vector<float>& depth) { input_depth_ = depth; }
 
   /// Grid scene flow from frame k-1 to frame k (organized, (width / w_grid) x (height / w_grid));
   /// the cell size w_grid is inferred from it (FlowGrid::fromFlow()).
@@ -297,6 +306,7 @@ private:
   Motions motions_;                          ///< T_curr_prev of each output segment
   PixelLabelRefinement refinement_;          ///< cell labels to pixel labels
   std::vector<std::uint8_t> pixel_labels_;   ///< label per pixel of the last segment()
+  std::vector<float> input_depth_;           ///< setInputDepth(); empty: the cloud's z
   /// s_axial, s_lateral: the sensor model's gains on its axial and lateral sigma, fitted
   /// over the frames
   std::array<float, 2> noise_gains_{1.0f, 1.0f};

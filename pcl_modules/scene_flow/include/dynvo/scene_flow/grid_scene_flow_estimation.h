@@ -90,6 +90,12 @@ public:
 
   const PointCloudConstPtr& getPreviousCloud() const { return previous_; }
 
+  /** \brief The input cloud's z as compute() read it, row-major (metres, NaN where not
+   * finite), for the stages after this one (RigidMotionSegmentation::setInputDepth()).
+   * Empty until compute() has read the input cloud set last.
+   */
+  const std::vector<float>& getInputDepth() const { return depth_; }
+
   /** \brief Makes the current frame the previous one, keeping its pyramid and depth map.
    * The input cloud is cleared: set the next frame before calling compute() again.
    */
@@ -188,10 +194,12 @@ protected:
   /// (FlowGrid::isInferable()); logs PCL_ERROR and returns false otherwise.
   bool validateInputs() const;
 
-  /// Converts a cloud to grey levels and depths and prepares it in an engine slot.
+  /// Converts a cloud to grey levels and depths (into depth) and prepares it in an engine
+  /// slot.
   void prepareFrame(const PointCloud& cloud,
                     detail::GridFlowEngine::Slot slot,
-                    const detail::GridFlowEngine::FrameStamps& stamps);
+                    const detail::GridFlowEngine::FrameStamps& stamps,
+                    std::vector<float>& depth);
 
 private:
   /// Stores checked parameters and drops the prepared frames (they depend on them).
@@ -209,7 +217,7 @@ private:
   bool current_ready_ = false;    ///< engine current slot matches input_ and params_
   bool previous_ready_ = false; ///< engine previous slot matches previous_ and params_
   std::vector<std::uint8_t> grey_;     ///< conversion buffer (grey levels)
-  std::vector<float> depth_;           ///< conversion buffer (metres)
+  std::vector<float> depth_;           ///< the input cloud's z (getInputDepth())
   std::vector<std::uint8_t> selected_; ///< cells computeToKeyframe() tracks
   Eigen::Matrix4f predicted_motion_ = Eigen::Matrix4f::Identity(); ///< H_pred
 };

@@ -24,6 +24,7 @@ void
 RigidMotionSegmentation<PointT>::setInputCloud(const PointCloudConstPtr& cloud)
 {
   Base::setInputCloud(cloud);
+  input_depth_.clear();
 }
 
 template <typename PointT>
@@ -142,8 +143,10 @@ RigidMotionSegmentation<PointT>::computeImplPixelLabels()
   const std::uint32_t* rgba = nullptr;
   if constexpr (pcl::traits::has_color<PointT>::value)
     rgba = &(*input_)[0].rgba;
-  refinement_.refine(output_grid_, fallback, &(*input_)[0].z, rgba, stride,
-                     pixel_labels_);
+  const bool image = input_depth_.size() == input_->size();
+  refinement_.refine(output_grid_, fallback,
+                     image ? input_depth_.data() : &(*input_)[0].z, image ? 1 : stride,
+                     rgba, stride, pixel_labels_);
 }
 
 template <typename PointT>

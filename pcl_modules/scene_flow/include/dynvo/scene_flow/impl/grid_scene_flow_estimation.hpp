@@ -23,6 +23,7 @@ GridSceneFlowEstimation<PointT>::setInputCloud(const PointCloudConstPtr& cloud)
   Base::setInputCloud(cloud);
   current_ready_ = false;
   input_stamps_ = {};
+  depth_.clear();
 }
 
 template <typename PointT>
@@ -45,6 +46,7 @@ GridSceneFlowEstimation<PointT>::shiftCurrentToPrevious()
   input_.reset();
   current_ready_ = false;
   input_stamps_ = {};
+  depth_.clear();
 }
 
 template <typename PointT>
@@ -136,17 +138,18 @@ void
 GridSceneFlowEstimation<PointT>::prepareFrame(
     const PointCloud& cloud,
     detail::GridFlowEngine::Slot slot,
-    const detail::GridFlowEngine::FrameStamps& stamps)
+    const detail::GridFlowEngine::FrameStamps& stamps,
+    std::vector<float>& depth)
 {
   const std::size_t size = cloud.size();
   grey_.resize(size);
-  depth_.resize(size);
+  depth.resize(size);
   for (std::size_t i = 0; i < size; ++i) {
     const PointT& p = cloud[i];
     grey_[i] = luma(p.r, p.g, p.b);
-    depth_[i] = std::isfinite(p.z) ? p.z : std::numeric_limits<float>::quiet_NaN();
+    depth[i] = std::isfinite(p.z) ? p.z : std::numeric_limits<float>::quiet_NaN();
   }
-  engine_.prepare(slot, grey_, depth_, cloud.width, cloud.height, params_, threads_,
+  engine_.prepare(slot, grey_, depth, cloud.width, cloud.height, params_, threads_,
                   stamps);
 }
 
@@ -165,10 +168,13 @@ GridSceneFlowEstimation<PointT>::compute(FlowCloud& flow)
   if (!validateInputs())
     return;
   if (!current_ready_)
-    prepareFrame(*input_, detail::GridFlowEngine::Slot::current, input_stamps_);
+    prepareFrame(*input_, detail::GridFlowEngine::Slot::current, input_stamps_, depth_);
   current_ready_ = true;
-  if (!previous_ready_)
-    prepareFrame(*previous_, detail::GridFlowEngine::Slot::previous, previous_stamps_);
+  if (!previous_ready_) { // the first pair, or a previous cloud set apart
+    std::vector<float> depth;
+    prepareFrame(*previous_, detail::GridFlowEngine::Slot::previous, previous_stamps_,
+                 depth);
+  }
   previous_ready_ = true;
   engine_.compute(params_, intrinsics_, threads_,
                   rigidInverse(predicted_motion_.cast<double>()).cast<float>(), flow);
