@@ -210,6 +210,12 @@ struct DirectFrame::SampleCache {
   std::vector<std::vector<Sample>> levels;
 };
 
+const DirectFrame::Level&
+DirectFrame::level(int l) const
+{
+  return levels_[static_cast<std::size_t>(l)];
+}
+
 const DirectFrame::SampleCache&
 DirectFrame::samples(const FlowGrid& cells,
                      const CameraIntrinsics& intrinsics,
@@ -251,7 +257,7 @@ estimateDirectOdometry(const DirectFrame& source,
   const DirectFrame::SampleCache& target_samples =
       target.samples(target_cells, intrinsics, parameters.rgbd_max_depth);
   for (int l = DirectFrame::LEVELS - 1; l >= 0; --l) {
-    const DirectFrame::Level& s = source.levels_[l];
+    const DirectFrame::Level& s = source.level(l);
     const LevelCamera camera(intrinsics, s.scale);
     const std::vector<Sample>& samples = target_samples.levels[l];
     const StaticLookup isStatic(source_cells, s.width, s.height, s.scale);

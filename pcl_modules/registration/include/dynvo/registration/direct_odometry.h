@@ -37,9 +37,13 @@ public:
   DirectFrame(const DirectFrame&) = delete;
   DirectFrame& operator=(const DirectFrame&) = delete;
 
-private:
+  /// One level's images, and a target's samples per level: defined where they are used
+  /// (src/direct_odometry.cpp, estimateDirectOdometry()).
   struct Level;
   struct SampleCache;
+
+  /// Level l (0 = finest, < LEVELS).
+  const Level& level(int l) const;
 
   /// The samples of this frame as the target of an alignment, per level: chosen once for a
   /// given mask, camera and depth limit (the step and its refit share them).
@@ -47,18 +51,10 @@ private:
                              const CameraIntrinsics& intrinsics,
                              float max_depth) const;
 
+private:
   std::vector<Level> levels_;
   /// empty until samples(), reset by buildPyramid()
   mutable std::unique_ptr<SampleCache> samples_;
-
-  friend bool estimateDirectOdometry(const DirectFrame&,
-                                     const FlowGrid&,
-                                     const DirectFrame&,
-                                     const FlowGrid&,
-                                     const CameraIntrinsics&,
-                                     const StaticMaskRegistrationParameters&,
-                                     const Eigen::Matrix4f&,
-                                     Eigen::Matrix4f&);
 };
 
 /** \brief The camera motion from source to target that best explains the target's textured
