@@ -383,6 +383,11 @@ TEST_F(Reliability, MessagesNameTheFileAndTheProblem)
   expectFailure(result, 1, rgb + ": colour image is a truncated PNG");
   EXPECT_EQ(result.err.find("libpng"), std::string::npos) << result.err;
 
+  // An empty file (a recording cut while it was written) is named as such.
+  fs::resize_file(rgb, 0);
+  result = runCommand(ODOMETRY + " -tum_dir " + seq + " -out " + out);
+  expectFailure(result, 1, rgb + ": colour image is empty (0 bytes)");
+
   // A file name of 100,000 characters is cut in the message.
   const std::string name(100000, 'n');
   writeText(seq + "/rgb.txt", "1.0 " + name + ".png\n");

@@ -42,6 +42,8 @@ readImageFile(const std::string& path,
     throw pcl::IOException(path + ": cannot read " + what + " (no such file)");
   const std::vector<unsigned char> bytes{std::istreambuf_iterator<char>(in),
                                          std::istreambuf_iterator<char>()};
+  if (bytes.empty()) // cv::imdecode would only say "!buf.empty()"
+    throw pcl::IOException(path + ": " + what + " is empty (0 bytes)");
   if (bytes.size() >= sizeof(PNG_SIGNATURE) &&
       std::equal(std::begin(PNG_SIGNATURE), std::end(PNG_SIGNATURE), bytes.begin())) {
     if (bytes.size() < PNG_MIN_SIZE)
