@@ -148,7 +148,7 @@ TEST(PipelineConfig, HelpListsEveryKeyWithItsDefault)
   EXPECT_NE(help.find("  scene_flow.epsilon 0.03 "), std::string::npos) << help;
   EXPECT_NE(help.find("  segmentation.inlier_threshold 6e-05 "), std::string::npos)
       << help;
-  EXPECT_NE(help.find("  registration.backend flow "), std::string::npos) << help;
+  EXPECT_NE(help.find("  registration.backend direct "), std::string::npos) << help;
 }
 
 } // namespace

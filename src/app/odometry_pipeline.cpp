@@ -129,6 +129,7 @@ PipelineOptions::PipelineOptions()
 {
   scene_flow.depth_window_radius = 6;
   segmentation.inlier_threshold = 6e-5f;
+  backend.backend = RegistrationBackend::direct;
 }
 
 void
@@ -197,15 +198,15 @@ struct OdometryPipeline::Impl {
   void track(const Cloud::ConstPtr& cloud, double depth_stamp)
   {
     const auto flow_start = Clock::now();
-    // The direct backend reads the cloud into its pyramids now, while the cloud is in the
-    // cache (2.2 ms at the registration, after the flow and the segmentation).
-    backend.setInputSource(cloud);
     flow_estimation.shiftCurrentToPrevious();
     flow_estimation.setInputCloud(cloud);
     flow_estimation.setInputStamps(result.timestamp, depth_stamp);
     flow_estimation.setPredictedMotion(T_curr_prev_predicted.cast<float>());
     auto flow = pcl::make_shared<pcl::PointCloud<PointFlow>>();
     flow_estimation.compute(*flow);
+    // The direct backend builds its pyramids from the grey levels and depths the flow read.
+    backend.setInputSource(cloud, flow_estimation.getInputGrey(),
+                           flow_estimation.getInputDepth());
     result.times.scene_flow_ms = millisecondsSince(flow_start);
     frame_flow = flow;
 

@@ -30,11 +30,13 @@ namespace dynvo::app {
 
 /// Every knob of the pipeline: the modules' parameters plus the pipeline's own.
 struct DYNVO_EXPORTS PipelineOptions {
-  /// The modules' defaults, except two (the measurements behind them: src/app/NOTES.md):
+  /// The modules' defaults, except three (the measurements behind them: src/app/NOTES.md):
   /// - the segmentation's inlier threshold: 6e-5 m^2 (7.7 mm) instead of the paper's 3e-5,
   ///   for real Kinect noise; it is also the upper bound of the noise-following threshold;
   /// - the scene flow's depth window radius: 6 px (a 7x7 sample of a 13x13 window) instead
-  ///   of the single pixel, so that the depth noise at c_i stays below the inlier radius.
+  ///   of the single pixel, so that the depth noise at c_i stays below the inlier radius;
+  /// - the ego-motion backend: direct (docs/algorithm.md §7.7) instead of the flow fit alone,
+  ///   more accurate on every real clip.
   PipelineOptions();
 
   CameraIntrinsics intrinsics;        ///< back-projection of the input frames
@@ -59,7 +61,7 @@ struct DYNVO_EXPORTS PipelineOptions {
   unsigned threads = 1; ///< worker threads; results do not depend on it
   /// Keyframe registration (docs/algorithm.md §7.3): the static cells of each frame are also
   /// registered against the current keyframe, which gives the pose; false: frame to frame.
-  /// Only with the flow backend (backend.backend); the other backends run frame to frame.
+  /// Only with the flow and direct backends (backend.backend); the others run frame to frame.
   bool keyframes = true;
   /// A new keyframe is taken when the inliers of the fit to the keyframe drop below this
   /// share of those of the first fit to it (static overlap, (0, 1]) ...

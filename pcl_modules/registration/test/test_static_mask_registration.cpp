@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <dynvo/registration/static_mask_registration.h>
+#include <dynvo/common/image.h>
 
 #include "registration_scene.h"
 
@@ -209,6 +210,46 @@ TEST_F(StaticMaskRegistrationTest, DirectBackendReadsACloudChangedInPlaceWithANe
   EXPECT_LT(translationError(moved, truth()), 2e-3);
   EXPECT_GT(translationError(moved, Eigen::Matrix4d::Identity()),
             0.5 * translationError(Eigen::Matrix4f::Identity(), truth()));
+}
+
+TEST_F(StaticMaskRegistrationTest, DirectBackendTakesTheImagesAnEarlierStageRead)
+{
+  // The pipeline hands the direct backend the grey levels and depths the scene flow already
+  // read from frame k. Built from the same values, the pyramids and so the estimate must be
+  // exactly those of reading the cloud; images of the wrong size fall back to the cloud; and
+  // images that differ from the cloud must be what the backend uses.
+  const auto& cloud = pair_.current.cloud;
+  std::vector<std::uint8_t> grey(cloud->size());
+  std::vector<float> depth(cloud->size());
+  for (std::size_t i = 0; i < cloud->size(); ++i) {
+    const Point& p = (*cloud)[i];
+    grey[i] = dynvo::luma(p.r, p.g, p.b);
+    depth[i] = p.z;
+  }
+  const auto estimate = [&](const std::vector<std::uint8_t>* source_grey) {
+    dynvo::StaticMaskRegistration<Point> backend;
+    backend.setBackend(RegistrationBackend::direct);
+    backend.setCameraIntrinsics(scene_.intrinsics);
+    if (source_grey)
+      backend.setInputSource(cloud, *source_grey, depth);
+    else
+      backend.setInputSource(cloud);
+    backend.setInputTarget(pair_.previous.cloud);
+    backend.setSourceStaticCells(staticCellsOf(pair_.current, scene_, pair_.grid));
+    backend.setTargetStaticCells(staticCellsOf(pair_.previous, scene_, pair_.grid));
+    Eigen::Matrix4f result = Eigen::Matrix4f::Zero();
+    backend.align(guess(), result);
+    return result;
+  };
+  const Eigen::Matrix4f from_cloud = estimate(nullptr);
+  EXPECT_LT(translationError(from_cloud, truth()), 2e-3);
+  EXPECT_EQ(estimate(&grey), from_cloud);
+  const std::vector<std::uint8_t> none;
+  EXPECT_EQ(estimate(&none), from_cloud);
+  std::vector<std::uint8_t> inverted(grey);
+  for (std::uint8_t& level : inverted)
+    level = static_cast<std::uint8_t>(255 - level);
+  EXPECT_GT(translationError(estimate(&inverted), truth()), 2e-3);
 }
 
 TEST_F(StaticMaskRegistrationTest, BrokenInputIsReportedAndLeavesTheGuess)

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <dynvo/scene_flow/grid_scene_flow_estimation.h>
+#include <dynvo/common/image.h>
 
 #include "support/pose_compare.h"
 #include "support/synthetic_scene.h"
@@ -10,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 #include <stdexcept>
@@ -392,33 +394,39 @@ TYPED_TEST(GridSceneFlowTest, ShiftCurrentToPreviousMatchesAFreshComputation)
   EXPECT_TRUE(identical(this->flow_, expected));
 }
 
-TYPED_TEST(GridSceneFlowTest, InputDepthIsTheZOfTheInputCloud)
+TYPED_TEST(GridSceneFlowTest, InputDepthAndGreyAreThoseOfTheInputCloud)
 {
   const auto scene = staticRoom();
   const auto f0 = this->view(scene, Eigen::Isometry3d::Identity());
   const auto f1 = this->view(scene, pose(0, 0.4, 0, 0.01, 0, 0));
   const auto f2 = this->view(scene, pose(0, 0.8, 0, 0.02, 0.005, 0));
-  // z of every point, NaN where it has none; the views differ, so a mix-up shows.
-  const auto matches = [](const std::vector<float>& depth, const auto& cloud) {
-    if (depth.size() != cloud.size())
+  // z and grey level of every point, NaN where it has no z; the views differ, so a mix-up
+  // shows.
+  const auto matches = [](const auto& estimation, const auto& cloud) {
+    const std::vector<float>& depth = estimation.getInputDepth();
+    const std::vector<std::uint8_t>& grey = estimation.getInputGrey();
+    if (depth.size() != cloud.size() || grey.size() != cloud.size())
       return false;
     for (std::size_t i = 0; i < depth.size(); ++i)
       if (!(depth[i] == cloud[i].z ||
-            (std::isnan(depth[i]) && !std::isfinite(cloud[i].z))))
+            (std::isnan(depth[i]) && !std::isfinite(cloud[i].z))) ||
+          grey[i] != dynvo::luma(cloud[i].r, cloud[i].g, cloud[i].b))
         return false;
     return true;
   };
-  ASSERT_FALSE(matches(std::vector<float>(f1.cloud->size()), *f1.cloud));
   auto& estimation = this->estimation_;
-  // The first pair prepares the previous cloud too: the depth stays the input's.
+  // The first pair prepares the previous cloud too: depth and grey stay the input's.
   this->run(f0.cloud, f1.cloud);
-  EXPECT_TRUE(matches(estimation.getInputDepth(), *f1.cloud));
+  EXPECT_TRUE(matches(estimation, *f1.cloud));
+  EXPECT_FALSE(matches(estimation, *f0.cloud));
   estimation.shiftCurrentToPrevious();
   EXPECT_TRUE(estimation.getInputDepth().empty());
+  EXPECT_TRUE(estimation.getInputGrey().empty());
   estimation.setInputCloud(f2.cloud);
   EXPECT_TRUE(estimation.getInputDepth().empty()); // not read before compute()
+  EXPECT_TRUE(estimation.getInputGrey().empty());
   estimation.compute(this->flow_);
-  EXPECT_TRUE(matches(estimation.getInputDepth(), *f2.cloud));
+  EXPECT_TRUE(matches(estimation, *f2.cloud));
 }
 
 /// The camera of a steady sweep at t seconds: 60 deg/s about y, 0.3 m/s sideways and
@@ -472,7 +480,8 @@ TYPED_TEST(GridSceneFlowTest, FlowEndsAreThePointsAtTheDepthInstants)
   };
   const double without = median_error(false);
   const double with = median_error(true);
-  this->RecordProperty("median_error_mm_without_stamps", std::to_string(without * 1000.0));
+  this->RecordProperty("median_error_mm_without_stamps",
+                       std::to_string(without * 1000.0));
   this->RecordProperty("median_error_mm_with_stamps", std::to_string(with * 1000.0));
   // With the stamps, the tolerance of the synchronised test (5 mm: LK's 0.2 px and the
   // bilinear depth on the slanted board); the velocity is the track's over one interval,

@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -30,6 +31,10 @@ public:
   /// after resize() and before buildPyramid().
   float* grey();
   float* depth();
+
+  /// Fills the finest level from width x height grey levels (luma()) and depths (metres, NaN
+  /// where none), row-major, after resize() and before buildPyramid().
+  void assign(const std::uint8_t* grey, const float* depth);
 
   /// Builds the coarser levels from the finest.
   void buildPyramid();

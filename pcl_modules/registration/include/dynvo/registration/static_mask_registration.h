@@ -112,10 +112,19 @@ public:
   /// per cloud (set it while the cloud is still in the cache).
   void setInputSource(const PointCloudConstPtr& cloud)
   {
-    source_ = cloud;
     if (cloud && params_.backend == RegistrationBackend::direct)
-      directFrameOf(cloud);
+      directFrameOf(cloud, source_);
+    source_ = cloud;
   }
+
+  /** \brief Frame k with its grey levels (luma()) and depths (metres, NaN where none) as an
+   * earlier stage read them from it, row-major (GridSceneFlowEstimation::getInputGrey() and
+   * getInputDepth()): the direct backend builds its pyramids from them instead of reading the
+   * cloud again. When they do not hold one value per point (e.g. empty), the cloud is read.
+   */
+  void setInputSource(const PointCloudConstPtr& cloud,
+                      const std::vector<std::uint8_t>& grey,
+                      const std::vector<float>& depth);
 
   /// Frame k-1 (organized, metres, the source's size).
   void setInputTarget(const PointCloudConstPtr& cloud) { target_ = cloud; }
@@ -155,10 +164,18 @@ private:
   Status alignDirect(const Eigen::Matrix4f& guess, Eigen::Matrix4f& T_prev_curr);
 
   /// The pyramids of a cloud, built once for its alignments as frame k and as frame k-1 (the
-  /// same pointer and header stamp; a cloud changed in place needs a new stamp); in_use is
-  /// not evicted.
+  /// same pointer and header stamp; a cloud changed in place needs a new stamp); those of
+  /// keep are not evicted.
   const detail::DirectFrame& directFrameOf(const PointCloudConstPtr& cloud,
-                                           const detail::DirectFrame* in_use = nullptr);
+                                           const PointCloudConstPtr& keep);
+
+  /// The pyramids built for this cloud, or null.
+  const detail::DirectFrame* builtFrameOf(const PointCloudConstPtr& cloud) const;
+
+  /// An entry for a cloud without pyramids, its finest level sized and left to fill: the
+  /// buffers of the entry that does not hold keep's pyramids.
+  detail::DirectFrame& claimDirectFrame(const PointCloudConstPtr& cloud,
+                                        const PointCloudConstPtr& keep);
 
   std::string class_name_ = "StaticMaskRegistration"; ///< log prefix
   Parameters params_;                                 ///< validated knobs
@@ -174,7 +191,7 @@ private:
     std::uint64_t stamp = 0;
     std::unique_ptr<detail::DirectFrame> frame;
   };
-  std::array<DirectEntry, 2> direct_frames_; ///< the last two, newest first
+  std::array<DirectEntry, 2> direct_frames_; ///< frames k and k-1, in either order
 };
 
 } // namespace dynvo

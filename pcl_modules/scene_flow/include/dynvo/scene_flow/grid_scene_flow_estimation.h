@@ -96,6 +96,12 @@ public:
    */
   const std::vector<float>& getInputDepth() const { return depth_; }
 
+  /** \brief The input cloud's grey levels (luma()) as compute() read them, row-major, for the
+   * stages after this one (StaticMaskRegistration::setInputSource()). Empty until compute()
+   * has read the input cloud set last.
+   */
+  const std::vector<std::uint8_t>& getInputGrey() const { return grey_; }
+
   /** \brief Makes the current frame the previous one, keeping its pyramid and depth map.
    * The input cloud is cleared: set the next frame before calling compute() again.
    */
@@ -194,11 +200,12 @@ protected:
   /// (FlowGrid::isInferable()); logs PCL_ERROR and returns false otherwise.
   bool validateInputs() const;
 
-  /// Converts a cloud to grey levels and depths (into depth) and prepares it in an engine
-  /// slot.
+  /// Converts a cloud to grey levels and depths (into grey and depth) and prepares it in an
+  /// engine slot.
   void prepareFrame(const PointCloud& cloud,
                     detail::GridFlowEngine::Slot slot,
                     const detail::GridFlowEngine::FrameStamps& stamps,
+                    std::vector<std::uint8_t>& grey,
                     std::vector<float>& depth);
 
 private:
@@ -214,10 +221,10 @@ private:
   detail::GridFlowEngine engine_; ///< pyramids and preprocessed depth of both frames
   detail::GridFlowEngine::FrameStamps input_stamps_;    ///< of the input cloud
   detail::GridFlowEngine::FrameStamps previous_stamps_; ///< of the previous cloud
-  bool current_ready_ = false;    ///< engine current slot matches input_ and params_
+  bool current_ready_ = false;  ///< engine current slot matches input_ and params_
   bool previous_ready_ = false; ///< engine previous slot matches previous_ and params_
-  std::vector<std::uint8_t> grey_;     ///< conversion buffer (grey levels)
-  std::vector<float> depth_;           ///< the input cloud's z (getInputDepth())
+  std::vector<std::uint8_t> grey_; ///< the input cloud's grey levels (getInputGrey())
+  std::vector<float> depth_;       ///< the input cloud's z (getInputDepth())
   std::vector<std::uint8_t> selected_; ///< cells computeToKeyframe() tracks
   Eigen::Matrix4f predicted_motion_ = Eigen::Matrix4f::Identity(); ///< H_pred
 };

@@ -129,33 +129,64 @@ StaticMaskRegistration<PointT>::alignImages(const Eigen::Matrix4f& guess,
 }
 
 template <typename PointT>
-const detail::DirectFrame&
-StaticMaskRegistration<PointT>::directFrameOf(const PointCloudConstPtr& cloud,
-                                              const detail::DirectFrame* in_use)
+const detail::DirectFrame*
+StaticMaskRegistration<PointT>::builtFrameOf(const PointCloudConstPtr& cloud) const
 {
   for (const DirectEntry& entry : direct_frames_)
     if (entry.cloud == cloud && entry.stamp == cloud->header.stamp)
-      return *entry.frame;
-  // The older entry's buffers take the new cloud, unless they hold the frame in use.
-  const std::size_t reused =
-      direct_frames_[1].frame && direct_frames_[1].frame.get() == in_use ? 0 : 1;
-  std::swap(direct_frames_[0], direct_frames_[reused]);
-  DirectEntry& entry = direct_frames_[0];
+      return entry.frame.get();
+  return nullptr;
+}
+
+template <typename PointT>
+detail::DirectFrame&
+StaticMaskRegistration<PointT>::claimDirectFrame(const PointCloudConstPtr& cloud,
+                                                 const PointCloudConstPtr& keep)
+{
+  DirectEntry& entry = direct_frames_[keep && direct_frames_[0].cloud == keep ? 1 : 0];
   entry.cloud = cloud;
   entry.stamp = cloud->header.stamp;
-  auto& frame = entry.frame;
-  if (!frame)
-    frame = std::make_unique<detail::DirectFrame>();
-  frame->resize(static_cast<int>(cloud->width), static_cast<int>(cloud->height));
-  float* grey = frame->grey();
-  float* depth = frame->depth();
+  if (!entry.frame)
+    entry.frame = std::make_unique<detail::DirectFrame>();
+  entry.frame->resize(static_cast<int>(cloud->width), static_cast<int>(cloud->height));
+  return *entry.frame;
+}
+
+template <typename PointT>
+const detail::DirectFrame&
+StaticMaskRegistration<PointT>::directFrameOf(const PointCloudConstPtr& cloud,
+                                              const PointCloudConstPtr& keep)
+{
+  if (const detail::DirectFrame* built = builtFrameOf(cloud))
+    return *built;
+  detail::DirectFrame& frame = claimDirectFrame(cloud, keep);
+  float* grey = frame.grey();
+  float* depth = frame.depth();
   for (std::size_t i = 0; i < cloud->size(); ++i) {
     const PointT& p = (*cloud)[i];
     grey[i] = luma(p.r, p.g, p.b);
     depth[i] = std::isfinite(p.z) ? p.z : std::numeric_limits<float>::quiet_NaN();
   }
-  frame->buildPyramid();
-  return *frame;
+  frame.buildPyramid();
+  return frame;
+}
+
+template <typename PointT>
+void
+StaticMaskRegistration<PointT>::setInputSource(const PointCloudConstPtr& cloud,
+                                               const std::vector<std::uint8_t>& grey,
+                                               const std::vector<float>& depth)
+{
+  if (cloud && (grey.size() != cloud->size() || depth.size() != cloud->size())) {
+    setInputSource(cloud);
+    return;
+  }
+  if (cloud && params_.backend == RegistrationBackend::direct && !builtFrameOf(cloud)) {
+    detail::DirectFrame& frame = claimDirectFrame(cloud, source_);
+    frame.assign(grey.data(), depth.data());
+    frame.buildPyramid();
+  }
+  source_ = cloud;
 }
 
 template <typename PointT>
@@ -170,8 +201,8 @@ StaticMaskRegistration<PointT>::alignDirect(const Eigen::Matrix4f& guess,
   };
   if (!enoughPoints(staticPixels(source_cells_), staticPixels(target_cells_)))
     return Status::too_few_points;
-  const detail::DirectFrame& source = directFrameOf(source_);
-  const detail::DirectFrame& target = directFrameOf(target_, &source);
+  const detail::DirectFrame& source = directFrameOf(source_, target_);
+  const detail::DirectFrame& target = directFrameOf(target_, source_);
   return detail::estimateDirectOdometry(source, source_cells_, target, target_cells_,
                                         intrinsics_, params_, guess, T_prev_curr)
              ? Status::converged

@@ -23,6 +23,7 @@ GridSceneFlowEstimation<PointT>::setInputCloud(const PointCloudConstPtr& cloud)
   Base::setInputCloud(cloud);
   current_ready_ = false;
   input_stamps_ = {};
+  grey_.clear();
   depth_.clear();
 }
 
@@ -46,6 +47,7 @@ GridSceneFlowEstimation<PointT>::shiftCurrentToPrevious()
   input_.reset();
   current_ready_ = false;
   input_stamps_ = {};
+  grey_.clear();
   depth_.clear();
 }
 
@@ -139,17 +141,18 @@ GridSceneFlowEstimation<PointT>::prepareFrame(
     const PointCloud& cloud,
     detail::GridFlowEngine::Slot slot,
     const detail::GridFlowEngine::FrameStamps& stamps,
+    std::vector<std::uint8_t>& grey,
     std::vector<float>& depth)
 {
   const std::size_t size = cloud.size();
-  grey_.resize(size);
+  grey.resize(size);
   depth.resize(size);
   for (std::size_t i = 0; i < size; ++i) {
     const PointT& p = cloud[i];
-    grey_[i] = luma(p.r, p.g, p.b);
+    grey[i] = luma(p.r, p.g, p.b);
     depth[i] = std::isfinite(p.z) ? p.z : std::numeric_limits<float>::quiet_NaN();
   }
-  engine_.prepare(slot, grey_, depth, cloud.width, cloud.height, params_, threads_,
+  engine_.prepare(slot, grey, depth, cloud.width, cloud.height, params_, threads_,
                   stamps);
 }
 
@@ -168,12 +171,14 @@ GridSceneFlowEstimation<PointT>::compute(FlowCloud& flow)
   if (!validateInputs())
     return;
   if (!current_ready_)
-    prepareFrame(*input_, detail::GridFlowEngine::Slot::current, input_stamps_, depth_);
+    prepareFrame(*input_, detail::GridFlowEngine::Slot::current, input_stamps_, grey_,
+                 depth_);
   current_ready_ = true;
   if (!previous_ready_) { // the first pair, or a previous cloud set apart
+    std::vector<std::uint8_t> grey;
     std::vector<float> depth;
     prepareFrame(*previous_, detail::GridFlowEngine::Slot::previous, previous_stamps_,
-                 depth);
+                 grey, depth);
   }
   previous_ready_ = true;
   engine_.compute(params_, intrinsics_, threads_,
