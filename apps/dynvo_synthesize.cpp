@@ -19,7 +19,8 @@ namespace {
 const char* const USAGE =
     "dynvo_synthesize -out DIR [-scenario NAME] [-frames N] [-seed S] [-clean] "
     "[-threads N] [-width W -height H] | -composite TUM_DIR -scenario NAME -out DIR "
-    "[-frames N] [-seed S] [-camera C] [-fx -fy -cx -cy] [-depth_scale S] | -list";
+    "[-frames N] [-seed S] [-camera C] [-fx -fy -cx -cy] [-distortion K] [-depth_scale "
+    "S] | -list";
 
 /// \throws dynvo::app::UsageError when the options are out of range
 void
@@ -105,7 +106,8 @@ main(int argc, char** argv)
          "render the scenario's objects into this real recording (its ground truth "
          "gives the camera; -frames N takes the first N frames, default all)"}};
     for (const dynvo::app::Option& option : dynvo::app::frameSourceOptions())
-      for (const char* name : {"camera", "fx", "fy", "cx", "cy", "depth_scale"})
+      for (const char* name :
+           {"camera", "fx", "fy", "cx", "cy", "distortion", "depth_scale"})
         if (option.name == name)
           options_list.push_back(option);
     const dynvo::app::Arguments args(argc, argv, options_list, 0);
@@ -136,7 +138,8 @@ main(int argc, char** argv)
       throw dynvo::app::UsageError("-out DIR is required");
     if (args.has("composite"))
       return composite(args);
-    for (const char* name : {"camera", "fx", "fy", "cx", "cy", "depth_scale"})
+    for (const char* name :
+         {"camera", "fx", "fy", "cx", "cy", "distortion", "depth_scale"})
       if (args.has(name))
         throw dynvo::app::UsageError(std::string("-") + name + " needs -composite");
 

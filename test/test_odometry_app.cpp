@@ -479,6 +479,15 @@ TEST_F(OdometryApp, BadFlagsAndMissingInput)
       << reference.err;
   EXPECT_EQ(runCommand(run("-bench_reference")).exit_code, 2); // no value
   EXPECT_EQ(runCommand(run("-threads 0")).exit_code, 2);
+  for (const char* distortion :
+       {"0.1,0,0,0", "0.1,0,0,0,0,0", "0.1,,0,0,0", "0.1,0,0,0,x"}) {
+    const auto lens = runCommand(run(std::string("-distortion ") + distortion));
+    EXPECT_EQ(lens.exit_code, 2) << distortion;
+    EXPECT_NE(lens.err.find("'-distortion' expects 5 comma-separated numbers, got '" +
+                            std::string(distortion) + "'"),
+              std::string::npos)
+        << lens.err;
+  }
   const auto every =
       runCommand(run("-clouds_dir " + out_.file("c") + " -clouds_every 0"));
   EXPECT_EQ(every.exit_code, 2);

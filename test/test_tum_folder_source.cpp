@@ -47,6 +47,7 @@ protected:
   {
     dynvo::TumFolderSource::Options o;
     o.intrinsics = dynvo::CameraIntrinsics::fromPreset("fr1");
+    o.intrinsics.distortion = {}; // 4x3 images: no lens to undistort
     return o;
   }
 
@@ -75,6 +76,7 @@ TEST_F(TumFolderTest, AssociatesAndBuildsMetricOrganizedClouds)
   ASSERT_TRUE(source.next(frame));
   EXPECT_DOUBLE_EQ(frame.timestamp, 1.0);
   ASSERT_TRUE(frame.cloud);
+  EXPECT_FALSE(frame.undistortion); // the images are the recording's
   ASSERT_EQ(frame.cloud->width, 4u);
   ASSERT_EQ(frame.cloud->height, 3u);
   EXPECT_TRUE(frame.cloud->isOrganized());
@@ -181,6 +183,11 @@ TEST(TumFolderRealData, Fr1XyzHas200AssociatedPairs)
   EXPECT_DOUBLE_EQ(frame.timestamp, 1305031102.175304);
   ASSERT_EQ(frame.cloud->width, 640u);
   ASSERT_EQ(frame.cloud->height, 480u);
+  // The fr1 lens is undistorted as the frame is read. It barrels the image out, so the
+  // undistorted image's corners see past the recording's edge: black, with no depth.
+  ASSERT_TRUE(frame.undistortion);
+  EXPECT_TRUE(std::isnan((*frame.cloud)(0, 0).z));
+  EXPECT_EQ(frame.color.data[0] + frame.color.data[1] + frame.color.data[2], 0);
   std::size_t valid = 0;
   double sum_z = 0.0;
   for (const auto& p : frame.cloud->points)

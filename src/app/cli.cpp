@@ -84,6 +84,31 @@ Arguments::number(const std::string& name, double fallback) const
   return value;
 }
 
+std::vector<double>
+Arguments::numbers(const std::string& name,
+                   std::size_t count,
+                   const std::vector<double>& fallback) const
+{
+  if (!has(name))
+    return fallback;
+  const std::string text = string(name);
+  std::vector<double> values;
+  bool parsed = true;
+  for (std::size_t begin = 0; parsed;) {
+    const std::size_t end = text.find(',', begin);
+    double value = 0.0;
+    parsed = parseDecimal(text.substr(begin, end - begin), value);
+    values.push_back(value);
+    if (end == std::string::npos)
+      break;
+    begin = end + 1;
+  }
+  if (!parsed || values.size() != count)
+    throw UsageError("option '-" + name + "' expects " + std::to_string(count) +
+                     " comma-separated numbers, got '" + text + "'");
+  return values;
+}
+
 long
 Arguments::integer(const std::string& name, long fallback) const
 {

@@ -7,6 +7,7 @@
 #include <pcl/console/print.h>
 
 #include <cstdint>
+#include <algorithm>
 #include <limits>
 
 namespace dynvo::app {
@@ -26,6 +27,10 @@ frameSourceOptions()
       {"fy", "PX", "focal length y, overrides the preset"},
       {"cx", "PX", "principal point x, overrides the preset"},
       {"cy", "PX", "principal point y, overrides the preset"},
+      {"distortion", "K1,K2,P1,P2,K3",
+       "lens distortion (OpenCV's order; 0,0,0,0,0 for none), overrides the preset; "
+       "the "
+       "images are undistorted as they are read"},
       {"depth_scale", "S",
        "raw depth units per metre (default: 5000 TUM, 1000 associations.txt)"},
       {"fps", "HZ",
@@ -50,6 +55,10 @@ intrinsicsFromArguments(const Arguments& args)
   intrinsics.fy = args.number("fy", intrinsics.fy);
   intrinsics.cx = args.number("cx", intrinsics.cx);
   intrinsics.cy = args.number("cy", intrinsics.cy);
+  const auto& k = intrinsics.distortion;
+  const std::vector<double> distortion =
+      args.numbers("distortion", k.size(), std::vector<double>(k.begin(), k.end()));
+  std::copy(distortion.begin(), distortion.end(), intrinsics.distortion.begin());
   try {
     intrinsics.validate();
   }

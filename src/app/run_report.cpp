@@ -4,6 +4,7 @@
 #include <dynvo/common/timestamps.h>
 #include <dynvo/eval/trajectory_metrics.h>
 #include <dynvo/io/label_io.h>
+#include <dynvo/common/lens_undistortion.h>
 #include <dynvo/io/partial_file.h>
 
 #include <pcl/exceptions.h>
@@ -61,10 +62,13 @@ RunOutputs::add(const Frame& frame, const FrameResult& result)
 
   // A frame the pipeline could not process (result.error) has no image to label.
   if (result.error.empty()) {
-    if (!paths_.labels_dir.empty())
+    if (!paths_.labels_dir.empty()) {
+      // On the recording's pixels, where the frame was undistorted.
+      const LabelImage labels{result.width, result.height, result.labels};
       writeLabelImage(
           (fs::path(paths_.labels_dir) / stampedPngName(result.timestamp)).string(),
-          {result.width, result.height, result.labels});
+          frame.undistortion ? frame.undistortion->distort(labels) : labels);
+    }
     if (!paths_.clouds_dir.empty() &&
         (trajectory_.size() - 1) % paths_.clouds_every == 0)
       writeLabelledCloud(

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <dynvo/common/camera.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -14,11 +15,12 @@ struct Preset {
 };
 
 // TUM values: https://cvg.cit.tum.de/data/datasets/rgbd-dataset/file_formats (ROS default
-// for "default"); ICSL-DE values from the dataset page (docs/algorithm.md §8).
+// for "default"; fr3's images are already undistorted); ICSL-DE values from the dataset page
+// (docs/algorithm.md §8).
 const Preset PRESETS[] = {
     {"default", {525.0, 525.0, 319.5, 239.5}},
-    {"fr1", {517.3, 516.5, 318.6, 255.3}},
-    {"fr2", {520.9, 521.0, 325.1, 249.7}},
+    {"fr1", {517.3, 516.5, 318.6, 255.3, {0.2624, -0.9531, -0.0054, 0.0026, 1.1633}}},
+    {"fr2", {520.9, 521.0, 325.1, 249.7, {0.2312, -0.7849, -0.0033, -0.0001, 0.9172}}},
     {"fr3", {535.4, 539.2, 320.1, 247.6}},
     {"icsl", {537.5999, 539.0333, 316.1487, 245.5187}},
 };
@@ -57,6 +59,18 @@ CameraIntrinsics::validate() const
         "values finite, got fx=" +
         std::to_string(fx) + " fy=" + std::to_string(fy) + " cx=" + std::to_string(cx) +
         " cy=" + std::to_string(cy));
+  for (const double k : distortion)
+    if (!std::isfinite(k))
+      throw std::invalid_argument(
+          "[dynvo::CameraIntrinsics::validate] distortion coefficients must be finite");
+}
+
+bool
+CameraIntrinsics::distorted() const
+{
+  return std::any_of(distortion.begin(), distortion.end(), [](double k) {
+    return k != 0.0;
+  });
 }
 
 } // namespace dynvo

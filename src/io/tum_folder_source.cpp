@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <dynvo/common/timestamps.h>
 #include <dynvo/io/image_io.h>
+#include <dynvo/common/lens_undistortion.h>
 #include <dynvo/io/tum_folder_source.h>
 
 #include <pcl/console/print.h>
@@ -183,6 +184,14 @@ TumFolderSource::read(std::size_t i) const
       frame.color.height != frame.depth.height)
     fail((dir / entry.depth_file).string() + ": depth image size differs from " +
          entry.rgb_file);
+  if (options_.intrinsics.distorted()) {
+    if (!undistortion_ || undistortion_->width() != frame.color.width ||
+        undistortion_->height() != frame.color.height)
+      undistortion_ = std::make_shared<const LensUndistortion>(
+          options_.intrinsics, frame.color.width, frame.color.height);
+    undistortion_->undistort(frame.color, frame.depth);
+    frame.undistortion = undistortion_;
+  }
   frame.cloud = makeOrganizedCloud(frame.color, frame.depth, options_.intrinsics);
   return frame;
 }

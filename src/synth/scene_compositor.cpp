@@ -71,6 +71,9 @@ SceneCompositor::setRecording(const CameraIntrinsics& intrinsics,
   T_world_camera_ = T_world_camera;
   width_ = first_color.width;
   height_ = first_color.height;
+  lens_ = intrinsics.distorted()
+              ? std::make_shared<const LensUndistortion>(intrinsics, width_, height_)
+              : nullptr;
 
   // Placement: scale about the scenario's camera at frame 0 (see the class docs).
   const double t0 = rgb_stamps_[0];
@@ -157,7 +160,10 @@ SceneCompositor::composite(std::size_t k,
       const float real_z = raw == 0 ? nan : static_cast<float>(raw / depth_scale_);
       samples[i].z = real_z;
       PixelHit hit;
-      if (!view.cast(u, v, hit) || hit.surface.z >= real_z) // NaN compares false
+      const Eigen::Vector2f ray =
+          lens_ ? lens_->undistortedPixel(u, v)
+                : Eigen::Vector2f(static_cast<float>(u), static_cast<float>(v));
+      if (!view.cast(ray.x(), ray.y(), hit) || hit.surface.z >= real_z) // NaN: false
         continue;
       samples[i] = hit.surface;
       visible[i] = 1;

@@ -293,7 +293,7 @@ SceneView::movingRectangle(int& u0, int& u1, int& v0, int& v1) const
 }
 
 bool
-SceneView::cast(int u, int v, PixelHit& out) const
+SceneView::cast(float u, float v, PixelHit& out) const
 {
   const CameraIntrinsics& K = intrinsics_;
   // Ray with unit z in the camera frame: its parameter at a hit is the depth z.

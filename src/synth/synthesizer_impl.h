@@ -59,8 +59,9 @@ public:
             bool with_room);
   ~SceneView();
 
-  /// Casts the ray of pixel (u, v); false (and `out` untouched) when nothing is hit.
-  bool cast(int u, int v, PixelHit& out) const;
+  /// Casts the ray of pixel (u, v) (pinhole, sub-pixel allowed); false (and `out`
+  /// untouched) when nothing is hit.
+  bool cast(float u, float v, PixelHit& out) const;
 
   /// Pixel rectangle holding every moving object (inclusive); false when none moves.
   bool movingRectangle(int& u0, int& u1, int& v0, int& v1) const;

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Per-frame cost of the grid scene flow stage at VGA on real TUM fr1/xyz frames.
+#include <dynvo/common/lens_undistortion.h>
 #include <dynvo/io/tum_folder_source.h>
 #include <dynvo/scene_flow/depth_preprocessing.h>
 #include <dynvo/scene_flow/grid_scene_flow_estimation.h>
@@ -156,5 +157,26 @@ BENCHMARK(BM_DepthPreprocessing)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+
+/// Undistorting one VGA frame's colour and depth through the fr1 lens, as TumFolderSource does
+/// before the pipeline (docs/algorithm.md §0); outside the pipeline's timers.
+void
+BM_LensUndistortion(benchmark::State& state)
+{
+  if (skipWithoutData(state))
+    return;
+  const dynvo::Frame& frame = frames()[1];
+  const dynvo::LensUndistortion lens(dynvo::CameraIntrinsics::fromPreset("fr1"),
+                                     frame.color.width, frame.color.height);
+  for (auto _ : state) {
+    state.PauseTiming();
+    dynvo::ColorImage color = frame.color;
+    dynvo::DepthImage depth = frame.depth;
+    state.ResumeTiming();
+    lens.undistort(color, depth);
+    benchmark::DoNotOptimize(depth.data.data());
+  }
+}
+BENCHMARK(BM_LensUndistortion)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 } // namespace

@@ -54,6 +54,12 @@ public:
   /// The flag's value as a finite number. \throws UsageError when it does not parse
   double number(const std::string& name, double fallback) const;
 
+  /// The flag's value as exactly count comma-separated finite numbers, or fallback when
+  /// absent. \throws UsageError when it does not parse or has another count
+  std::vector<double> numbers(const std::string& name,
+                              std::size_t count,
+                              const std::vector<double>& fallback) const;
+
   /// The flag's value as an integer. \throws UsageError when it does not parse
   long integer(const std::string& name, long fallback) const;
 

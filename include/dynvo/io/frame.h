@@ -10,10 +10,13 @@
 #include <pcl/point_types.h>
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace dynvo {
+
+class LensUndistortion;
 
 /** \brief One RGB-D frame as delivered by a FrameSource. */
 struct Frame {
@@ -25,6 +28,9 @@ struct Frame {
       cloud;        ///< organized, current camera frame (metres), NaN where no depth
   ColorImage color; ///< the colour image the cloud was made from
   DepthImage depth; ///< the depth image the cloud was made from (metres)
+  /// How color and depth were undistorted from the recording's images; null when the
+  /// camera has no lens distortion (the images are the recording's)
+  std::shared_ptr<const LensUndistortion> undistortion;
 };
 
 /// Default frame-size limit of the readers (pixels, 4096 x 4096): a frame costs about

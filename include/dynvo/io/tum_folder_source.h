@@ -6,6 +6,7 @@
 #include <dynvo/io/frame_source.h>
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -22,7 +23,9 @@ namespace dynvo {
 class DYNVO_EXPORTS TumFolderSource : public FrameSource {
 public:
   struct Options {
-    CameraIntrinsics intrinsics; ///< default preset (525, 525, 319.5, 239.5)
+    /// default preset (525, 525, 319.5, 239.5); with lens distortion, every frame is
+    /// undistorted (Frame::undistortion)
+    CameraIntrinsics intrinsics;
     double depth_scale =
         0.0; ///< raw units per metre; 0 = 5000 (TUM) or 1000 (associations.txt)
     double max_difference = 0.02; ///< association tolerance (seconds)
@@ -63,6 +66,8 @@ private:
   double depth_scale_;
   std::vector<Entry> entries_;
   std::size_t cursor_ = 0;
+  /// The intrinsics' undistortion at the last frame's size (made on the first frame)
+  mutable std::shared_ptr<const LensUndistortion> undistortion_;
 };
 
 } // namespace dynvo

@@ -5,11 +5,13 @@
 #include <dynvo/common/camera.h>
 #include <dynvo/common/export.h>
 #include <dynvo/common/image.h>
+#include <dynvo/common/lens_undistortion.h>
 #include <dynvo/synth/scene_synthesizer.h>
 
 #include <Eigen/Geometry>
 
 #include <cstddef>
+#include <memory>
 #include <vector>
 
 namespace dynvo {
@@ -39,7 +41,9 @@ struct CompositeFrame {
  * first frame's mean brightness, and depth through DepthSensorModel (its edges and
  * shadows seeing the real depth around them). Every other pixel keeps the recording's
  * colour and depth (depth rescaled to DEPTH_PNG_SCALE when the recording's scale
- * differs). No motion blur (it would smear into real pixels).
+ * differs). No motion blur (it would smear into real pixels). With a lens that distorts
+ * (CameraIntrinsics::distortion), each pixel casts the ray the lens gives it, so the objects
+ * are distorted as the recording is.
  */
 class DYNVO_EXPORTS SceneCompositor {
 public:
@@ -79,6 +83,7 @@ public:
 private:
   SceneSynthesizer synth_;
   CameraIntrinsics intrinsics_;
+  std::shared_ptr<const LensUndistortion> lens_; ///< null without distortion
   double depth_scale_ = 0.0;
   std::vector<double> rgb_stamps_;
   std::vector<Eigen::Isometry3d> T_world_camera_;
