@@ -64,7 +64,7 @@ LensUndistortion::LensUndistortion(const CameraIntrinsics& intrinsics,
       pixels.at<cv::Vec2f>(v * size.width + u) =
           cv::Vec2f(static_cast<float>(u), static_cast<float>(v));
   cv::Mat undistorted;
-  // Iterated to 0.001 px: OpenCV's default 5 steps leave pixels off near the corners.
+  // Iterated until the step is below 0.001 px (OpenCV's default stops after 5 steps).
   cv::undistortPoints(pixels, undistorted, K, distortion, cv::noArray(), K,
                       cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
                                        50,

@@ -18,7 +18,7 @@ namespace dynvo {
  * Back-projection of pixel (u, v) at depth z (metres) is
  * x = [(u - cx) z / fx, (v - cy) z / fy, z], in the OpenCV optical frame. It holds for
  * undistorted images: a reader undistorts the images of a camera with distortion
- * (LensUndistortion, docs/algorithm.md §1.2) before anything else sees them.
+ * (LensUndistortion, docs/algorithm.md §0) before anything else sees them.
  */
 struct DYNVO_EXPORTS CameraIntrinsics {
   double fx = 525.0; ///< focal length along x (px)

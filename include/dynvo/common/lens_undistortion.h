@@ -15,12 +15,13 @@
 namespace dynvo {
 
 /** \brief Undistorts the colour and depth images of one camera and image size
- * (docs/algorithm.md §1.2).
+ * (docs/algorithm.md §0).
  *
  * The undistorted image has the camera's own fx, fy, cx, cy and no distortion, so every
  * later stage may back-project with CameraIntrinsics::backproject(). Colour is interpolated
  * bilinearly; depth takes the nearest pixel, so no depth is mixed across an edge. A pixel
- * that sees nothing of the distorted image is black with no depth. distort() takes a label
+ * that sees nothing of the distorted image (a frame of 6-27 px around a fr1 image) is black
+ * with no depth. distort() takes a label
  * image of the undistorted geometry back to the recording's pixels, so masks lie on the
  * images the user has.
  */
@@ -41,7 +42,8 @@ public:
   /// this size
   void undistort(ColorImage& color, DepthImage& depth) const;
 
-  /// Where the recording's pixel (u, v) lies in the undistorted image (px).
+  /// Where the recording's pixel (u, v) (u < width(), v < height()) lies in the
+  /// undistorted image (px).
   Eigen::Vector2f undistortedPixel(std::uint32_t u, std::uint32_t v) const;
 
   /// Labels of the undistorted geometry at the recording's pixels (nearest; 0 where a
