@@ -668,8 +668,9 @@ runFr1Recording(const std::string& folder, const Configure& configure = {})
 TEST(OdometryPipeline, FramesNoFlowFitMeasuresAreRecoveredByTheDenseFit)
 {
   // No flow fit can pass here (each needs more cells than the 1200 of the grid), as on a
-  // blurred frame after a gap: every frame goes to OpenCV's dense RGB-D odometry on the
-  // previous frame's static mask, started from the prediction (docs/algorithm.md §7.5).
+  // blurred frame after a gap: every frame goes to OpenCV's dense RGB-D odometry, started
+  // from the prediction, on every cell (no frame is measured by a flow fit, so none is called
+  // moving; docs/algorithm.md §7.5).
   const auto starved = [](dynvo::app::PipelineOptions& o) {
     o.registration.min_correspondences = 2000;
   };

@@ -262,8 +262,10 @@ struct OdometryPipeline::Impl {
             ? T_curr_prev_predicted
             : rigidInverse(registration.getFinalTransformation().cast<double>());
     alignOnStaticMask();
-    if (!result.lost)
+    if (!result.lost) {
       previous_static_cells = selection.getStaticCells();
+      markUnmovedCells();
+    }
     result.times.registration_ms = millisecondsSince(registration_start);
   }
 
@@ -462,17 +464,37 @@ struct OdometryPipeline::Impl {
     }
   }
 
+  /** Marks in unmoved_cells the cells of this measured frame that nothing calls moving:
+   * neither the segmentation (an object's label) nor the motion evidence. Without
+   * segmentation every cell.
+   */
+  void markUnmovedCells()
+  {
+    const FlowGrid& cells = selection.getStaticCells();
+    unmoved_cells = cells;
+    const auto called = [&](const FlowGrid& grid, std::size_t i, std::uint8_t above) {
+      return grid.sameGeometry(cells) && grid.labels.size() == cells.labels.size() &&
+             grid.labels[i] > above;
+    };
+    for (std::size_t i = 0; i < cells.labels.size(); ++i) {
+      const bool moving = options.use_segmentation &&
+                          (called(segmentation.getCellGrid(), i, LABEL_STATIC) ||
+                           called(evidence.getMovingCells(), i, LABEL_NONE));
+      unmoved_cells.labels[i] = moving ? LABEL_NONE : LABEL_STATIC;
+    }
+  }
+
   /** A frame that no flow fit measured (docs/algorithm.md §7.5): OpenCV's dense RGB-D
-   * odometry against the previous frame on its static mask (both frames), from the
-   * prediction. Taken when it converges within the motion bound and within tau_cv of the
-   * prediction: sets result.T_curr_prev and
-   * result.T_world_curr, clears result.lost and sets result.recovered.
+   * odometry against the previous frame, from the prediction, on the cells the last
+   * measured frame did not call moving (both frames). Taken when it converges within the
+   * motion bound: sets result.T_curr_prev and result.T_world_curr, clears result.lost and
+   * sets result.recovered.
    */
   void recoverDense(const Cloud::ConstPtr& cloud)
   {
     const auto start = Clock::now();
     // No frame measured yet: the start-up assumption, every cell static (docs §4).
-    FlowGrid mask = previous_static_cells;
+    FlowGrid mask = unmoved_cells;
     if (mask.size() == 0) {
       mask = FlowGrid(cloud->width, cloud->height,
                       static_cast<std::uint32_t>(options.scene_flow.cell_size));
@@ -486,14 +508,7 @@ struct OdometryPipeline::Impl {
     if (recovery.align(rigidInverse(T_curr_prev_predicted).cast<float>(),
                        T_prev_curr)) {
       const Eigen::Matrix4d T_curr_prev = rigidInverse(T_prev_curr.cast<double>());
-      // A blurred frame can pull the dense fit far: it may depart from the prediction by no
-      // more than tau_cv, the segmentation's background guard (the flow fits' wider
-      // tolerance grows with the predicted motion of the points, 19 cm on a fast turn).
-      const double departure = (T_curr_prev_predicted * T_prev_curr.cast<double>())
-                                   .topRightCorner<3, 1>()
-                                   .norm();
-      if (withinBound(T_curr_prev) &&
-          departure <= options.segmentation.static_guard_tolerance) {
+      if (withinBound(T_curr_prev)) {
         result.T_curr_prev = T_curr_prev;
         result.T_world_curr = T_world_prev * T_prev_curr.cast<double>();
         result.lost = false;
@@ -528,8 +543,10 @@ struct OdometryPipeline::Impl {
   StaticMaskRegistration<pcl::PointXYZRGB> backend;
   StaticMaskRegistration<pcl::PointXYZRGB>
       recovery; ///< dense, for frames no fit measured
-  /// the static set of the last measured frame (the backend's and the recovery's masks)
-  FlowGrid previous_static_cells;
+  FlowGrid
+      previous_static_cells; ///< the static set of the last measured frame (backend's)
+  FlowGrid
+      unmoved_cells; ///< the last measured frame's cells not called moving (recovery's)
   Cloud::ConstPtr previous;
   Eigen::Matrix4d T_world_prev =
       Eigen::Matrix4d::Identity();   ///< at the previous frame's depth instant

@@ -125,8 +125,9 @@ struct FrameResult {
   /// the constant-velocity prediction
   bool lost = false;
   LostReason lost_reason = LostReason::none; ///< why lost (none when not)
-  /// no flow fit measured the frame, and OpenCV's dense RGB-D odometry on the previous
-  /// frame's static mask recovered it (not lost; static_cells and residual are 0)
+  /// no flow fit measured the frame, and OpenCV's dense RGB-D odometry on the cells the
+  /// last measured frame did not call moving recovered it (not lost; static_cells and
+  /// residual are 0)
   bool recovered = false;
   /// static cells of the fit that gave the pose (its inliers; 0 when lost)
   std::size_t static_cells = 0;
