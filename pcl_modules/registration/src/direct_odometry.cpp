@@ -265,7 +265,7 @@ estimateDirectOdometry(const DirectFrame& source,
 {
   Eigen::Isometry3f T(Eigen::Isometry3f(guess).inverse()); // T_source_target
   float offset = 0.0f;
-  std::vector<float> residuals; // magnitudes, for the Huber threshold
+  std::vector<float> residuals; // magnitudes, for the robust scale
   const DirectFrame::SampleCache& target_samples =
       target.samples(target_cells, intrinsics, parameters.rgbd_max_depth);
   for (int l = DirectFrame::LEVELS - 1; l >= 0; --l) {
@@ -273,7 +273,7 @@ estimateDirectOdometry(const DirectFrame& source,
     const LevelCamera camera(intrinsics, s.scale);
     const std::vector<Sample>& samples = target_samples.levels[l];
     const StaticLookup isStatic(source_cells, s.width, s.height, s.scale);
-    float k = 0.0f; // Huber threshold of this level, from the first residuals' spread
+    float c = 0.0f; // Tukey's threshold of this level, from the first residuals' spread
     double last_cost = std::numeric_limits<double>::infinity();
     Eigen::Isometry3f last_T = T;
     float last_offset = offset;
@@ -299,7 +299,7 @@ estimateDirectOdometry(const DirectFrame& source,
           return none;
         return bilinear(s.grey, u, v) - sample.intensity - offset;
       };
-      if (iteration == 0) { // Huber's threshold of the level: 1.345 robust sigmas
+      if (iteration == 0) { // Tukey's threshold of the level: 4.685 robust sigmas
         residuals.clear();
         for (const Sample& sample : samples) {
           const float r = residualOf(sample);
@@ -310,7 +310,7 @@ estimateDirectOdometry(const DirectFrame& source,
           return false;
         const auto middle = residuals.begin() + residuals.size() / 2;
         std::nth_element(residuals.begin(), middle, residuals.end());
-        k = 1.345f * std::max(1.4826f * *middle, 1.0f);
+        c = 4.685f * std::max(1.4826f * *middle, 1.0f);
       }
       Eigen::Matrix<float, 8, 8> H = Eigen::Matrix<float, 8, 8>::Zero();
       Eigen::Matrix<float, 8, 1> g = Eigen::Matrix<float, 8, 1>::Zero();
@@ -320,9 +320,11 @@ estimateDirectOdometry(const DirectFrame& source,
         const float r = residualOf(sample);
         if (std::isnan(r))
           continue;
-        const float a = std::abs(r);
-        const float w = a <= k ? 1.0f : k / a;
-        cost += a <= k ? 0.5 * r * r : k * (a - 0.5 * k);
+        // Tukey's biweight: a residual beyond c (a mover, an occlusion) weighs nothing.
+        const float u = std::abs(r) / c;
+        const float b = u < 1.0f ? 1.0f - u * u : 0.0f;
+        const float w = b * b;
+        cost += (c * c / 6.0) * (1.0 - b * b * b);
         H.noalias() += (w * sample.jacobian) * sample.jacobian.transpose();
         g.noalias() += (w * r) * sample.jacobian;
         ++count;

@@ -63,7 +63,7 @@ private:
 };
 
 /** \brief The camera motion from source to target that best explains the target's textured
- * static pixels in the source image (photometric error with a brightness offset, Huber
+ * static pixels in the source image (photometric error with a brightness offset, Tukey
  * weights, inverse compositional Gauss-Newton from guess, coarse to fine; a step that raises
  * the cost ends its level).
  * \param[in] source frame k and its static cells
