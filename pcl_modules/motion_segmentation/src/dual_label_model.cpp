@@ -177,4 +177,20 @@ DualLabelModel::update(const std::vector<std::uint8_t>& measurement, float max_a
   }
 }
 
+void
+DualLabelModel::forgetCandidates(const std::vector<char>& in_use)
+{
+  const int known = std::min(labels_, static_cast<int>(in_use.size()) - 1);
+  for (std::size_t i = 0; i < age_c_.size(); ++i) {
+    float* pc = &p_c_[i * labels_];
+    for (int l = 1; l <= known; ++l)
+      if (!in_use[l])
+        pc[l - 1] = 0.0f;
+    if (std::all_of(pc, pc + labels_, [](float p) {
+          return p <= 0.0f;
+        }))
+      age_c_[i] = 0.0f;
+  }
+}
+
 } // namespace dynvo

@@ -148,9 +148,12 @@ SegmentTracker::collectUsedIds(int labels)
     for (const std::uint8_t l : map)
       used_[std::min<int>(l, labels)] = 1;
   for (std::size_t i = 0; i < model_.readOut().size(); ++i)
-    for (const auto m :
-         {DualLabelModel::Model::apparent, DualLabelModel::Model::candidate})
-      used_[model_.argmax(m, i)] = 1;
+    used_[model_.argmax(DualLabelModel::Model::apparent, i)] = 1;
+  used_[LABEL_STATIC] = 1;
+  // A candidate alone does not keep an id: an object no apparent model and no recent frame
+  // holds is gone, and its evidence would reserve the id for ever (a static real scene ran
+  // out of labels) and hand a later, unrelated segment a head start.
+  model_.forgetCandidates(used_);
 }
 
 int

@@ -87,6 +87,26 @@ TEST(DualLabelModel, YoungCandidateOvertakesYoungerApparent)
   EXPECT_FLOAT_EQ(model.age(Model::candidate, 0), 0.0f);
 }
 
+TEST(DualLabelModel, LabelsNotInUseLeaveTheCandidatesOnly)
+{
+  dynvo::DualLabelModel model;
+  model.reset(2, 1, 3);
+  model.setModel(Model::apparent, 0, {1, 0, 0}, 5.0f);
+  model.setModel(Model::candidate, 0, {0, 1, 0}, 2.0f);
+  model.setModel(Model::apparent, 1, {0, 1, 0}, 3.0f);
+  model.setModel(Model::candidate, 1, {0, 0.5f, 0.5f}, 2.0f);
+  model.forgetCandidates({0, 1, 0, 1}); // labels 1 and 3 in use, 2 gone
+  // Cell 0's candidate held only label 2: uninitialised. Cell 1's keeps label 3's share
+  // and its age. The apparent models are not touched, even cell 1's label 2.
+  EXPECT_FLOAT_EQ(model.age(Model::candidate, 0), 0.0f);
+  EXPECT_EQ(model.argmax(Model::candidate, 0), 0);
+  EXPECT_FLOAT_EQ(model.probability(Model::candidate, 1, 2), 0.0f);
+  EXPECT_FLOAT_EQ(model.probability(Model::candidate, 1, 3), 0.5f);
+  EXPECT_FLOAT_EQ(model.age(Model::candidate, 1), 2.0f);
+  EXPECT_FLOAT_EQ(model.probability(Model::apparent, 1, 2), 1.0f);
+  EXPECT_EQ(model.argmax(Model::apparent, 0), 1);
+}
+
 TEST(DualLabelModel, CompensatedModelIsUpdatedAsRunningAverage)
 {
   dynvo::DualLabelModel model;
@@ -274,25 +294,35 @@ TEST_F(BoxSequence, BoxCoveringMostOfTheImageDoesNotTakeTheBackgroundLabel)
   EXPECT_TRUE(segmentation.getMotions()[0].isIdentity(1e-4f));
 }
 
-/// Sets frame k of a box (8 x 14 cells at 1.2 m from column col0, 160 x 120, 4 px cells)
-/// moving `step` metres along x before a static background, with flow noise 0.5 mm per axis
-/// (a new draw every frame), as the input; returns the true label of each cell.
+/// Sets frame k of a box (cells [col0, col1) x [row0, row1) of `box` at 1.2 m, 160 x 120,
+/// 4 px cells) moving `step` metres along x before a static background, with flow noise 0.5
+/// mm per axis (a new draw every frame), as the input; returns the true label of each cell.
 std::vector<int>
-setBoxFrame(dynvo::RigidMotionSegmentation<pcl::PointXYZRGB>& segmentation,
-            int col0,
-            double step,
-            std::size_t k)
+setRegionFrame(dynvo::RigidMotionSegmentation<pcl::PointXYZRGB>& segmentation,
+               const std::array<int, 4>& box,
+               double step,
+               std::size_t k)
 {
   constexpr int CELL = 4;
   const auto synthetic = dynvo::test::makeSyntheticFlow(
       40, 30, CELL, dynvo::test::intrinsicsFor(160), Eigen::Matrix4d::Identity(),
-      {{col0, 8, col0 + 8, 22, 1.2,
+      {{box[0], box[1], box[2], box[3], 1.2,
         dynvo::test::makeMotion({0, 0, 1}, 0.0, {step, 0.0, 0.0}), 2}},
       5e-4, static_cast<std::uint32_t>(k + 1));
   segmentation.setInputCloud(
       dynvo::test::cloudFromFlow<pcl::PointXYZRGB>(*synthetic.flow, CELL));
   segmentation.setInputFlow(synthetic.flow);
   return synthetic.truth;
+}
+
+/// setRegionFrame() with the box of 8 x 14 cells from column col0, rows 8-21.
+std::vector<int>
+setBoxFrame(dynvo::RigidMotionSegmentation<pcl::PointXYZRGB>& segmentation,
+            int col0,
+            double step,
+            std::size_t k)
+{
+  return setRegionFrame(segmentation, {col0, 8, col0 + 8, 22}, step, k);
 }
 
 /// Segments the frame of setBoxFrame(); returns the segments and the true label of each cell.
@@ -409,6 +439,40 @@ TEST(ObjectBirth, ObjectOfTwoFramesIsNeverOutput)
       newObjectOutputs({false, false, false, true, true, false, false, false}, 3, 0.0f);
   for (std::size_t k = 0; k < outputs.size(); ++k)
     EXPECT_EQ(outputs[k], (std::vector<std::uint8_t>{1})) << "frame " << k;
+}
+
+TEST(ObjectBirth, ShortLivedObjectsDoNotUseUpTheLabels)
+{
+  // Twenty objects one after another, each in its own place, as the spurious objects of a
+  // real static scene: a box of 5 x 5 cells moves 4 cm for two frames, then stands still
+  // for twelve (more than the buffer's 5 frames and alpha_max's 5, after which no apparent
+  // model and no buffered map holds its id). Each is a new object with an id; with 14 ids
+  // for objects, the ids of gone objects must come free. Its cells keep candidate evidence
+  // of its id (two measurements against a static apparent model of age 5 never swap), and
+  // that evidence alone must not reserve the id.
+  dynvo::RigidMotionSegmentation<pcl::PointXYZRGB> segmentation;
+  segmentation.setCameraIntrinsics(dynvo::test::intrinsicsFor(160));
+  segmentation.setObjectBirthFrames(1);
+  segmentation.setObjectBirthRatio(0.0f);
+  std::size_t k = 0;
+  const auto frame = [&](int col0, int row0, double step) {
+    setRegionFrame(segmentation, {col0, row0, col0 + 5, row0 + 5}, step, k++);
+    std::vector<pcl::PointIndices> segments;
+    segmentation.segment(segments);
+    return segmentation.getSegmentLabels();
+  };
+  for (int still = 0; still < 3; ++still) // the background first
+    frame(2, 2, 0.0);
+  for (int object = 0; object < 20; ++object) {
+    const int col0 = 2 + 7 * (object % 5), row0 = 2 + 7 * (object / 5);
+    const std::vector<std::uint8_t> ids = frame(col0, row0, 0.04);
+    ASSERT_EQ(ids.size(), 2u) << "object " << object;
+    EXPECT_EQ(ids[0], 1) << "object " << object;
+    EXPECT_GE(ids[1], 2) << "object " << object;
+    frame(col0, row0, 0.04);
+    for (int still = 0; still < 12; ++still)
+      frame(col0, row0, 0.0);
+  }
 }
 
 TEST(ObjectBirth, NoObjectIsOutputOnAFrameWithoutBackground)

@@ -85,6 +85,13 @@ public:
    */
   void update(const std::vector<std::uint8_t>& measurement, float max_age);
 
+  /** \brief Clears every candidate model's probability of the labels not in use; a
+   * candidate left without any is uninitialised (age 0).
+   * \param[in] in_use nonzero at index l when label l is in use (labels at or beyond its
+   * size are kept)
+   */
+  void forgetCandidates(const std::vector<char>& in_use);
+
 private:
   const std::vector<float>& probabilities(Model model) const
   {

@@ -127,7 +127,10 @@ private:
                         const RigidMotionSegmentationParameters& params,
                         std::vector<int>& ids) const;
 
-  /// Marks the ids held by a buffered map or as argmax of an initialised model (used_).
+  /** Marks the ids in use (used_): the static label, the ids of the buffered maps and the
+   * argmax of every initialised apparent model. Candidate evidence for any other id is
+   * cleared (DualLabelModel::forgetCandidates()): its object is gone.
+   */
   void collectUsedIds(int labels);
 
   /// Smallest id in 2..n_obj neither in used_ nor in `taken`; 0 if none.
