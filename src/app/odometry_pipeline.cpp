@@ -543,10 +543,10 @@ struct OdometryPipeline::Impl {
   StaticMaskRegistration<pcl::PointXYZRGB> backend;
   StaticMaskRegistration<pcl::PointXYZRGB>
       recovery; ///< dense, for frames no fit measured
-  FlowGrid
-      previous_static_cells; ///< the static set of the last measured frame (backend's)
-  FlowGrid
-      unmoved_cells; ///< the last measured frame's cells not called moving (recovery's)
+  /// the static set of the last measured frame (the backend's target mask)
+  FlowGrid previous_static_cells;
+  /// the last measured frame's cells not called moving (the recovery's mask)
+  FlowGrid unmoved_cells;
   Cloud::ConstPtr previous;
   Eigen::Matrix4d T_world_prev =
       Eigen::Matrix4d::Identity();   ///< at the previous frame's depth instant
