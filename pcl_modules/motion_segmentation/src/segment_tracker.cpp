@@ -524,7 +524,8 @@ SegmentTracker::clearlyApart(const GridFlowData& grid, std::uint8_t id, double r
 }
 
 void
-SegmentTracker::updateAges(const GridFlowData& grid, bool first_pair, double separation_ratio)
+SegmentTracker::updateAges(const GridFlowData& grid,
+                           const RigidMotionSegmentationParameters& params)
 {
   constexpr int OLD = std::numeric_limits<int>::max();
   ages_.resize(256, 0);
@@ -538,7 +539,7 @@ SegmentTracker::updateAges(const GridFlowData& grid, bool first_pair, double sep
   for (const std::uint8_t id : ids_) {
     if (id == LABEL_STATIC)
       continue;
-    int age = first_pair ? OLD : ages_[id];
+    int age = ages_[id];
     if (age == 0) {
       // A new id over cells that mostly held one object: that object under a new id.
       std::array<int, 256> held{};
@@ -552,10 +553,15 @@ SegmentTracker::updateAges(const GridFlowData& grid, bool first_pair, double sep
       if (2 * *most >= cells)
         age = ages_[most - held.begin()];
     }
-    if (age != OLD && measured[id] && separation_ratio > 0.0 &&
-        clearlyApart(grid, id, separation_ratio))
+    if (age != OLD && measured[id] && params.object_birth_ratio > 0.0f &&
+        clearlyApart(grid, id, params.object_birth_ratio))
       age = OLD;
-    next[id] = age == OLD ? OLD : age + (measured[id] ? 1 : 0);
+    if (age == OLD)
+      next[id] = OLD;
+    else if (measured[id])
+      next[id] = age + 1;
+    else // a young object counts consecutive frames: a break starts its count again
+      next[id] = age >= params.object_birth_frames ? age : 0;
   }
   ages_ = std::move(next);
 }
@@ -576,7 +582,6 @@ SegmentTracker::update(const GridFlowData& grid,
     model_.reset(grid.cols(), grid.rows(), params.max_labels);
   }
   collectUsedIds(params.max_labels);
-  const bool first_pair = !hasHistory();
   for (auto& map : buffer_)
     map = warpNearest(map, grid);
 
@@ -605,7 +610,7 @@ SegmentTracker::update(const GridFlowData& grid,
   model_.update(tracked_, params.max_age);
 
   collectOutputs(grid, spatial, ids, T_pred);
-  updateAges(grid, first_pair, params.object_birth_ratio);
+  updateAges(grid, params);
   previous_fused_ = fused_;
   buffer_.push_front(tracked_);
   while (static_cast<int>(buffer_.size()) > params.buffer_length)

@@ -70,12 +70,13 @@ public:
   /// Fused output label per cell (see the class doc).
   const std::vector<std::uint8_t>& labels() const { return fused_; }
 
-  /** \brief Frames in which `id` was measured (in trackedLabels()) since it appeared among
-   * ids() without a break (frames in which only the model holds it do not count); an id
-   * that appears over cells that mostly held one object in the previous frame continues
-   * that object's count (the object under a new id). std::numeric_limits<int>::max() for the
-   * objects of a sequence's first pair (the start-up assumption), those continuing them, and
-   * those measured clearly apart from the background (object_birth_ratio, clearlyApart()).
+  /** \brief Consecutive frames in which `id` was measured (in trackedLabels()) while it
+   * is younger than object_birth_frames: a frame in which only the model or the label buffer
+   * holds it starts the count again; from object_birth_frames on, frames without a
+   * measurement keep the count. An id that appears over cells that mostly held one object in
+   * the previous frame continues that object's count (the object under a new id).
+   * std::numeric_limits<int>::max() for the objects measured clearly apart from the
+   * background (object_birth_ratio, clearlyApart()) and those continuing them.
    */
   int age(std::uint8_t id) const { return ages_.empty() ? 0 : ages_[id]; }
 
@@ -153,7 +154,8 @@ private:
                         const std::vector<int>& ids,
                         const RigidMotionSegmentationParameters& params);
   /// ages_ after this frame's outputs (see age()).
-  void updateAges(const GridFlowData& grid, bool first_pair, double separation_ratio);
+  void updateAges(const GridFlowData& grid,
+                  const RigidMotionSegmentationParameters& params);
 
   /// The cells of output id `id` fit the background's motion `ratio` times worse (RMS) than
   /// the id's own motion (discounted by its fit's 6 degrees of freedom).
