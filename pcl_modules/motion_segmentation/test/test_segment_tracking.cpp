@@ -312,13 +312,15 @@ setRegionFrame(dynvo::RigidMotionSegmentation<pcl::PointXYZRGB>& segmentation,
       {{box[0], box[1], box[2], box[3], 1.2,
         dynvo::test::makeMotion({0, 0, 1}, 0.0, {step, 0.0, 0.0}), 2}},
       5e-4, static_cast<std::uint32_t>(k + 1));
-  for (std::size_t i = 0; i < synthetic.truth.size() && !box_measured; ++i)
-    if (synthetic.truth[i] == 2) {
-      dynvo::PointFlow& cell = (*synthetic.flow)[i];
-      cell.prev_x = cell.prev_y = cell.prev_z = std::numeric_limits<float>::quiet_NaN();
-      cell.valid_3d = 0;
-      cell.weight = 0.0f;
-    }
+  if (!box_measured)
+    for (std::size_t i = 0; i < synthetic.truth.size(); ++i)
+      if (synthetic.truth[i] == 2) {
+        dynvo::PointFlow& cell = (*synthetic.flow)[i];
+        const float none = std::numeric_limits<float>::quiet_NaN();
+        cell.prev_x = cell.prev_y = cell.prev_z = none;
+        cell.valid_3d = 0;
+        cell.weight = 0.0f;
+      }
   segmentation.setInputCloud(
       dynvo::test::cloudFromFlow<pcl::PointXYZRGB>(*synthetic.flow, CELL));
   segmentation.setInputFlow(synthetic.flow);
