@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Dual-mode model, compensation, matching and tracking (docs/algorithm.md §4-§6).
+#include <dynvo/common/rigid_fit.h>
 #include <dynvo/motion_segmentation/dual_label_model.h>
 #include <dynvo/motion_segmentation/rigid_motion_segmentation.h>
 #include <dynvo/motion_segmentation/segment_tracker.h>
@@ -719,3 +720,69 @@ TEST(BackgroundGuard, MotionsAreComparedWithThePredictionOverTheWholeScene)
 }
 
 } // namespace
+
+TEST(ObjectSeparation, ObjectMergedWholeIntoTheBackgroundKeepsItsId)
+{
+  // A box (8 x 14 cells at 1.2 m) moves 3 mm per frame before a static background, flow
+  // noise 0.5 mm per axis. The two-frame segmentation is given by hand: the box is its own
+  // segment on both frames. Under the sensor model at gains 1 its residual under the
+  // background's motion is within the noise (median E at most th_chi2 / 2), so the noise-split
+  // merge hands its whole segment to the background on the second frame; that segment holds
+  // none of the background's former cells. Its cells still fit the background's motion about
+  // 3.6 times worse (RMS: sqrt(9 + 0.75) / sqrt(0.75) mm) than their own: measured against the
+  // background's former cells elsewhere, the box stays apart.
+  constexpr int CELL = 4, COLS = 40, ROWS = 30;
+  const dynvo::CameraIntrinsics intrinsics = dynvo::test::intrinsicsFor(160);
+  const dynvo::RigidMotionSegmentationParameters params;
+  dynvo::SegmentTracker tracker;
+  dynvo::GridFlowData grid;
+  std::vector<int> truth;
+  for (std::uint32_t k = 0; k < 3; ++k) {
+    const int col0 = k == 0 ? 8 : 9;
+    const double step = k < 2 ? 0.04 : 0.003;
+    const auto synthetic = dynvo::test::makeSyntheticFlow(
+        COLS, ROWS, CELL, intrinsics, Eigen::Matrix4d::Identity(),
+        {{col0, 8, col0 + 8, 22, 1.2,
+          dynvo::test::makeMotion({0, 0, 1}, 0.0, {step, 0.0, 0.0}), 2}},
+        5e-4, k + 1);
+    truth = synthetic.truth;
+    dynvo::FlowGrid geometry;
+    ASSERT_TRUE(dynvo::FlowGrid::fromFlow(*synthetic.flow, COLS * CELL, ROWS * CELL, geometry));
+    grid.assign(*synthetic.flow, geometry);
+    grid.setSensorNoise(params.noise, intrinsics.fx, 1.0f, 1.0f);
+    // Segment 1 the background, 2 the box, each with the motion fitted on its cells.
+    dynvo::SpatialSegmentationResult spatial;
+    spatial.labels.assign(grid.size(), 0);
+    spatial.sizes.assign(2, 0);
+    std::array<dynvo::RigidFitAccumulator, 2> fits;
+    for (std::size_t i = 0; i < grid.size(); ++i)
+      if (grid.valid_3d[i]) {
+        const int c = truth[i] == 2 ? 2 : 1;
+        spatial.labels[i] = static_cast<std::uint8_t>(c);
+        ++spatial.sizes[c - 1];
+        fits[c - 1].add(grid.a[i].cast<double>(), grid.b[i].cast<double>());
+      }
+    spatial.motions.resize(2);
+    for (int c = 0; c < 2; ++c)
+      ASSERT_EQ(fits[c].solve(spatial.motions[c]), dynvo::RigidFitStatus::ok);
+    spatial.inlier_threshold = params.inlier_chi2;
+    tracker.update(grid, spatial, Eigen::Matrix4d::Identity(), intrinsics, params);
+  }
+  // The premise: the box's cells fit the background's motion within the noise split merge's
+  // bound.
+  const Eigen::Matrix3f R = Eigen::Matrix3f::Identity();
+  const Eigen::Vector3f t = Eigen::Vector3f::Zero();
+  std::vector<float> box_errors;
+  std::size_t box_cells = 0, kept = 0;
+  for (std::size_t i = 0; i < grid.size(); ++i)
+    if (truth[i] == 2 && grid.valid_3d[i]) {
+      box_errors.push_back(grid.error(i, R, t));
+      ++box_cells;
+      kept += tracker.trackedLabels()[i] == 2 ? 1 : 0;
+    }
+  std::nth_element(box_errors.begin(), box_errors.begin() + box_errors.size() / 2,
+                   box_errors.end());
+  ASSERT_LE(box_errors[box_errors.size() / 2], 0.5f * params.inlier_chi2);
+  // Every box cell keeps the box's id (before: all of them became background).
+  EXPECT_EQ(kept, box_cells);
+}
