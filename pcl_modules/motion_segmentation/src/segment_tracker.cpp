@@ -11,6 +11,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <numeric>
 #include <tuple>
 
@@ -383,14 +384,8 @@ SegmentTracker::keepObjectsApart(const GridFlowData& grid,
   };
   // The former background cells of every label-1 segment: the reference of a segment with
   // too few of its own, an object merged whole into the background (its own segment, handed
-  // to label 1 by the noise-split merge).
-  RigidFitAccumulator former_background;
-  for (std::size_t i = 0; i < grid.size(); ++i)
-    if (spatial.labels[i] != 0 && ids[spatial.labels[i]] == LABEL_STATIC &&
-        grid.valid_3d[i] && previous[i] == LABEL_STATIC) {
-      const auto [a, b] = pair(i);
-      former_background.add(a, b);
-    }
+  // to label 1 by the noise-split merge). Gathered only when such a segment comes.
+  std::optional<RigidFitAccumulator> former_background;
   for (int c = 1; c <= g; ++c) {
     if (ids[c] != LABEL_STATIC)
       continue;
@@ -406,8 +401,17 @@ SegmentTracker::keepObjectsApart(const GridFlowData& grid,
       }
     // The background's motion where the segment is: a fit on its own former background
     // cells (one fit over all of them for every segment was worse on tum_fr1_desk_fast).
+    if (fits[LABEL_STATIC].size() < n_min && !former_background) {
+      former_background.emplace();
+      for (std::size_t i = 0; i < grid.size(); ++i)
+        if (spatial.labels[i] != 0 && ids[spatial.labels[i]] == LABEL_STATIC &&
+            grid.valid_3d[i] && previous[i] == LABEL_STATIC) {
+          const auto [a, b] = pair(i);
+          former_background->add(a, b);
+        }
+    }
     const RigidFitAccumulator& reference =
-        fits[LABEL_STATIC].size() >= n_min ? fits[LABEL_STATIC] : former_background;
+        fits[LABEL_STATIC].size() >= n_min ? fits[LABEL_STATIC] : *former_background;
     Eigen::Matrix4d H_background;
     if (reference.size() < n_min || reference.solve(H_background) != RigidFitStatus::ok)
       continue;
