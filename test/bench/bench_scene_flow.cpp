@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Per-frame cost of the grid scene flow stage at VGA on real TUM fr1/xyz frames.
+#include "real_frames.h"
+
 #include <dynvo/common/lens_undistortion.h>
-#include <dynvo/io/tum_folder_source.h>
 #include <dynvo/scene_flow/depth_preprocessing.h>
 #include <dynvo/scene_flow/grid_scene_flow_estimation.h>
 
@@ -10,53 +11,14 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
-#include <filesystem>
 #include <memory>
-#include <string>
 #include <vector>
 
 namespace {
 
-using Cloud = pcl::PointCloud<pcl::PointXYZRGB>;
-
-/// Frames 0..FRAMES-1 of the shared fr1/xyz clip, loaded once (PNG decoding is not timed).
-constexpr std::size_t FRAMES = 30;
-
-const std::vector<dynvo::Frame>&
-frames()
-{
-  static const std::vector<dynvo::Frame> loaded = [] {
-    std::vector<dynvo::Frame> result;
-    const std::string folder = std::string(DYNVO_SHARED_DATA_DIR) + "/tum_fr1_xyz_200";
-    if (!std::filesystem::exists(folder + "/rgb.txt"))
-      return result;
-    dynvo::TumFolderSource::Options options;
-    options.intrinsics = dynvo::CameraIntrinsics::fromPreset("fr1");
-    const dynvo::TumFolderSource source(folder, options);
-    for (std::size_t k = 0; k < FRAMES && k < source.size(); ++k)
-      result.push_back(source.read(k));
-    return result;
-  }();
-  return loaded;
-}
-
-/// Frame order 0, 1, ..., N-1, N-2, ..., 1, 0, 1, ...: every step is a real consecutive pair.
-std::size_t
-pingPong(std::size_t step, std::size_t n)
-{
-  const std::size_t period = 2 * (n - 1);
-  const std::size_t phase = step % period;
-  return phase < n ? phase : period - phase;
-}
-
-bool
-skipWithoutData(benchmark::State& state)
-{
-  if (frames().size() >= 2)
-    return false;
-  state.SkipWithError("tum_fr1_xyz_200 not found under DYNVO_SHARED_DATA_DIR");
-  return true;
-}
+using dynvo::bench::frames;
+using dynvo::bench::pingPong;
+using dynvo::bench::skipWithoutData;
 
 /// The whole stage per frame as a sequence runs it: depth preprocessing, one grey pyramid,
 /// forward LK, the forward-backward check and back-projection. Arg: thread count.

@@ -155,33 +155,54 @@ struct StaticLookup {
 template <typename Level>
 std::vector<Sample>
 samplesOf(const Level& level,
-          const StaticLookup& isStatic,
+          const FlowGrid& cells,
           const LevelCamera& camera,
           float max_depth)
 {
-  // The textured static pixels with depth, then at most BUDGET of them evenly spread.
-  std::vector<std::pair<int, int>> pixels;
+  // The textured static pixels with depth (y * width + x), then at most BUDGET of them
+  // evenly spread. The scan writes every pixel and keeps the ones taken: no branch per pixel.
   const int step = level.scale == 1 ? FINE_STEP : 1;
+  const int size = static_cast<int>(cells.cell_size);
+  std::vector<int> pixels(static_cast<std::size_t>(level.width / step + 1) *
+                          (level.height / step + 1));
+  std::size_t found = 0;
+  std::vector<std::uint8_t> static_columns(static_cast<std::size_t>(level.width));
+  int columns_row = -1; // the cell row static_columns holds
   for (int y = 1; y + 1 < level.height; y += step) {
+    const int cell_row = y * level.scale / size;
+    if (cell_row >= static_cast<int>(cells.rows))
+      break;
+    if (cell_row != columns_row) {
+      const std::uint8_t* labels =
+          &cells.labels[static_cast<std::size_t>(cell_row) * cells.cols];
+      for (int x = 0; x < level.width; ++x) {
+        const int cell = x * level.scale / size;
+        static_columns[x] =
+            cell < static_cast<int>(cells.cols) && labels[cell] == LABEL_STATIC;
+      }
+      columns_row = cell_row;
+    }
     const float* row = level.grey.template ptr<float>(y);
     const float* up = level.grey.template ptr<float>(y - 1);
     const float* down = level.grey.template ptr<float>(y + 1);
     const float* depth = level.depth.template ptr<float>(y);
     for (int x = 1; x + 1 < level.width; x += step) {
       const float z = depth[x];
-      if (!(z > 0.0f && z <= max_depth))
-        continue;
       const float gx = row[x + 1] - row[x - 1];
       const float gy = down[x] - up[x];
-      if (gx * gx + gy * gy >= 4.0f * MIN_GRADIENT * MIN_GRADIENT && isStatic(x, y))
-        pixels.emplace_back(x, y);
+      pixels[found] = y * level.width + x;
+      found += (z > 0.0f) & (z <= max_depth) &
+               (gx * gx + gy * gy >= 4.0f * MIN_GRADIENT * MIN_GRADIENT) &
+               (static_columns[x] != 0);
     }
   }
+  pixels.resize(found);
   const std::size_t count = std::min(pixels.size(), BUDGET);
   const double stride = count > 0 ? static_cast<double>(pixels.size()) / count : 0.0;
   std::vector<Sample> samples(count);
   for (std::size_t i = 0; i < count; ++i) {
-    const auto [x, y] = pixels[static_cast<std::size_t>(i * stride)];
+    const int pixel = pixels[static_cast<std::size_t>(i * stride)];
+    const int x = pixel % level.width, y = pixel / level.width;
     const float* row = level.grey.template ptr<float>(y);
     const float gx = 0.5f * (row[x + 1] - row[x - 1]);
     const float gy = 0.5f * (level.grey.template ptr<float>(y + 1)[x] -
@@ -247,8 +268,7 @@ DirectFrame::samples(const FlowGrid& cells,
   cache->max_depth = max_depth;
   for (const Level& level : levels_)
     cache->levels.push_back(
-        samplesOf(level, StaticLookup(cells, level.width, level.height, level.scale),
-                  LevelCamera(intrinsics, level.scale), max_depth));
+        samplesOf(level, cells, LevelCamera(intrinsics, level.scale), max_depth));
   samples_ = std::move(cache);
   return *samples_;
 }
@@ -265,7 +285,8 @@ estimateDirectOdometry(const DirectFrame& source,
 {
   Eigen::Isometry3f T(Eigen::Isometry3f(guess).inverse()); // T_source_target
   float offset = 0.0f;
-  std::vector<float> residuals; // magnitudes, for the robust scale
+  std::vector<float> residuals;  // per sample of a level
+  std::vector<float> magnitudes; // of the residuals, for the robust scale
   const DirectFrame::SampleCache& target_samples =
       target.samples(target_cells, intrinsics, parameters.rgbd_max_depth);
   for (int l = DirectFrame::LEVELS - 1; l >= 0; --l) {
@@ -273,6 +294,7 @@ estimateDirectOdometry(const DirectFrame& source,
     const LevelCamera camera(intrinsics, s.scale);
     const std::vector<Sample>& samples = target_samples.levels[l];
     const StaticLookup isStatic(source_cells, s.width, s.height, s.scale);
+    residuals.resize(samples.size());
     float c = 0.0f; // Tukey's threshold of this level, from the first residuals' spread
     double last_cost = std::numeric_limits<double>::infinity();
     Eigen::Isometry3f last_T = T;
@@ -299,34 +321,32 @@ estimateDirectOdometry(const DirectFrame& source,
           return none;
         return bilinear(s.grey, u, v) - sample.intensity - offset;
       };
+      // Each sample's residual under T, once per step; NaN where it has none.
+      for (std::size_t i = 0; i < samples.size(); ++i)
+        residuals[i] = residualOf(samples[i]);
       if (iteration == 0) { // Tukey's threshold of the level: 4.685 robust sigmas
-        residuals.clear();
-        for (const Sample& sample : samples) {
-          const float r = residualOf(sample);
+        magnitudes.clear();
+        for (const float r : residuals)
           if (!std::isnan(r))
-            residuals.push_back(std::abs(r));
-        }
-        if (residuals.size() < MIN_RESIDUALS)
+            magnitudes.push_back(std::abs(r));
+        if (magnitudes.size() < MIN_RESIDUALS)
           return false;
-        const auto middle = residuals.begin() + residuals.size() / 2;
-        std::nth_element(residuals.begin(), middle, residuals.end());
+        const auto middle = magnitudes.begin() + magnitudes.size() / 2;
+        std::nth_element(magnitudes.begin(), middle, magnitudes.end());
         c = 4.685f * std::max(1.4826f * *middle, 1.0f);
       }
-      Eigen::Matrix<float, 8, 8> H = Eigen::Matrix<float, 8, 8>::Zero();
-      Eigen::Matrix<float, 8, 1> g = Eigen::Matrix<float, 8, 1>::Zero();
+      // Tukey's biweight: a residual beyond c (a mover, an occlusion) weighs nothing.
+      const auto biweight = [c](float r) {
+        const float u = std::abs(r) / c;
+        return u < 1.0f ? 1.0f - u * u : 0.0f;
+      };
       double cost = 0.0;
       std::size_t count = 0;
-      for (const Sample& sample : samples) {
-        const float r = residualOf(sample);
+      for (const float r : residuals) {
         if (std::isnan(r))
           continue;
-        // Tukey's biweight: a residual beyond c (a mover, an occlusion) weighs nothing.
-        const float u = std::abs(r) / c;
-        const float b = u < 1.0f ? 1.0f - u * u : 0.0f;
-        const float w = b * b;
+        const float b = biweight(r);
         cost += (c * c / 6.0) * (1.0 - b * b * b);
-        H.noalias() += (w * sample.jacobian) * sample.jacobian.transpose();
-        g.noalias() += (w * r) * sample.jacobian;
         ++count;
       }
       if (count < MIN_RESIDUALS)
@@ -342,6 +362,17 @@ estimateDirectOdometry(const DirectFrame& source,
       last_offset = offset;
       if (iteration == MAX_ITERATIONS)
         break;
+      Eigen::Matrix<float, 8, 8> H = Eigen::Matrix<float, 8, 8>::Zero();
+      Eigen::Matrix<float, 8, 1> g = Eigen::Matrix<float, 8, 1>::Zero();
+      for (std::size_t i = 0; i < samples.size(); ++i) {
+        const float r = residuals[i];
+        if (std::isnan(r))
+          continue;
+        const float b = biweight(r);
+        const float w = b * b;
+        H.noalias() += (w * samples[i].jacobian) * samples[i].jacobian.transpose();
+        g.noalias() += (w * r) * samples[i].jacobian;
+      }
       const Eigen::Matrix<double, 7, 1> delta =
           H.topLeftCorner<7, 7>().cast<double>().ldlt().solve(
               g.head<7>().cast<double>());
