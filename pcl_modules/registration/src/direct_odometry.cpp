@@ -370,8 +370,14 @@ estimateDirectOdometry(const DirectFrame& source,
           continue;
         const float b = biweight(r);
         const float w = b * b;
-        H.noalias() += (w * samples[i].jacobian) * samples[i].jacobian.transpose();
-        g.noalias() += (w * r) * samples[i].jacobian;
+        // The lower triangle of H's 7x7 system, whole 4-float packets: LDLT reads no more.
+        const Eigen::Matrix<float, 8, 1>& J = samples[i].jacobian;
+        const Eigen::Matrix<float, 8, 1> wJ = w * J;
+        for (int j = 0; j < 4; ++j)
+          H.col(j) += wJ * J[j];
+        for (int j = 4; j < 7; ++j)
+          H.col(j).tail<4>() += wJ.tail<4>() * J[j];
+        g.noalias() += (w * r) * J;
       }
       const Eigen::Matrix<double, 7, 1> delta =
           H.topLeftCorner<7, 7>().cast<double>().ldlt().solve(
