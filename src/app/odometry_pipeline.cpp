@@ -204,11 +204,9 @@ struct OdometryPipeline::Impl {
     flow_estimation.setPredictedMotion(T_curr_prev_predicted.cast<float>());
     auto flow = pcl::make_shared<pcl::PointCloud<PointFlow>>();
     flow_estimation.compute(*flow);
-    // The direct backend builds its pyramids from the grey levels and depths the flow read.
-    backend.setInputSource(cloud, flow_estimation.getInputGrey(),
-                           flow_estimation.getInputDepth());
     result.times.scene_flow_ms = millisecondsSince(flow_start);
     frame_flow = flow;
+    startBackendInputs(cloud);
 
     const auto segmentation_start = Clock::now();
     // The guards' tolerances grow with the predicted motion (docs/algorithm.md §4, §7): the
@@ -261,6 +259,7 @@ struct OdometryPipeline::Impl {
         result.lost
             ? T_curr_prev_predicted
             : rigidInverse(registration.getFinalTransformation().cast<double>());
+    result.times.registration_ms += backend_inputs_ms.get();
     alignOnStaticMask();
     if (!result.lost) {
       previous_static_cells = selection.getStaticCells();
@@ -326,6 +325,29 @@ struct OdometryPipeline::Impl {
     result.segment_labels = segmentation.getSegmentLabels();
     result.motions = segmentation.getMotions();
     result.times.segmentation_ms += millisecondsSince(start);
+  }
+
+  /** The backend's inputs that do not depend on this frame's fits: the direct backend's
+   * pyramids of this frame (from the grey levels and depths the flow read) and the previous
+   * frame's samples on its static cells. With a second thread they are made beside the
+   * segmentation's cell stage, which runs on one; track() waits for them before the backend
+   * runs, and their time counts in registration_ms.
+   */
+  void startBackendInputs(const Cloud::ConstPtr& cloud)
+  {
+    const auto inputs = [this, cloud, target_cells = previous_static_cells] {
+      const auto start = Clock::now();
+      backend.setInputSource(cloud, flow_estimation.getInputGrey(),
+                             flow_estimation.getInputDepth());
+      backend.setInputTarget(previous);
+      if (target_cells.size() > 0) {
+        backend.setTargetStaticCells(target_cells);
+        backend.precomputeTarget();
+      }
+      return millisecondsSince(start);
+    };
+    backend_inputs_ms = options.threads > 1 ? std::async(std::launch::async, inputs)
+                                            : std::async(std::launch::deferred, inputs);
   }
 
   /** The segmentation's pixel stage (pixel labels and indices): nothing the fits do depends
@@ -537,6 +559,8 @@ struct OdometryPipeline::Impl {
   StaticSetSelection<pcl::PointXYZRGB> selection;
   MotionEvidence evidence;         ///< cells left out of the fits (with segmentation)
   std::future<double> segments_ms; ///< the pixel stage of this frame (startSegments())
+  /// the backend's inputs of this frame (startBackendInputs())
+  std::future<double> backend_inputs_ms;
   pcl::PointCloud<PointFlow>::ConstPtr
       frame_flow; ///< this frame's flow to the previous
   InlierNoiseTracker noise_tracker;

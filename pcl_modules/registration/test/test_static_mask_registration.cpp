@@ -252,6 +252,34 @@ TEST_F(StaticMaskRegistrationTest, DirectBackendTakesTheImagesAnEarlierStageRead
   EXPECT_GT(translationError(estimate(&inverted), truth()), 2e-3);
 }
 
+TEST_F(StaticMaskRegistrationTest, DirectTargetPrecomputedGivesTheSameEstimate)
+{
+  // The pipeline builds the target's samples beside other work (precomputeTarget()); align()
+  // must then reuse them and return exactly what it returns when it chooses them itself. Called
+  // before the target or its cells are set, it does nothing.
+  const auto estimate = [&](bool precompute) {
+    dynvo::StaticMaskRegistration<Point> backend;
+    backend.setBackend(RegistrationBackend::direct);
+    backend.setCameraIntrinsics(scene_.intrinsics);
+    backend.setInputSource(pair_.current.cloud);
+    if (precompute)
+      backend.precomputeTarget(); // no target yet
+    backend.setInputTarget(pair_.previous.cloud);
+    if (precompute)
+      backend.precomputeTarget(); // no target cells yet
+    backend.setTargetStaticCells(staticCellsOf(pair_.previous, scene_, pair_.grid));
+    if (precompute)
+      backend.precomputeTarget();
+    backend.setSourceStaticCells(staticCellsOf(pair_.current, scene_, pair_.grid));
+    Eigen::Matrix4f result = Eigen::Matrix4f::Zero();
+    EXPECT_TRUE(backend.align(guess(), result));
+    return result;
+  };
+  const Eigen::Matrix4f chosen_in_align = estimate(false);
+  EXPECT_LT(translationError(chosen_in_align, truth()), 2e-3);
+  EXPECT_EQ(estimate(true), chosen_in_align);
+}
+
 TEST_F(StaticMaskRegistrationTest, BrokenInputIsReportedAndLeavesTheGuess)
 {
   backend_.setBackend(RegistrationBackend::cv_rgbd);

@@ -135,6 +135,14 @@ public:
   /// Static cells of frame k-1 (labelled LABEL_STATIC), on a grid over the target image.
   void setTargetStaticCells(const FlowGrid& cells) { target_cells_ = cells; }
 
+  /** \brief With the direct backend, builds the target's pyramids (when not kept from its
+   * use as a source) and chooses its samples for the target's static cells now instead of in
+   * the next align(), with the same result: a caller may run this beside other work. Does
+   * nothing with the other backends, or when the target or its cells are not set (align()
+   * reports that).
+   */
+  void precomputeTarget();
+
   /** \brief Runs the backend from guess.
    * \param[in] guess initial T_prev_curr (metres), e.g. the flow estimate
    * \param[out] T_prev_curr the backend's estimate, or guess when it failed (getStatus())

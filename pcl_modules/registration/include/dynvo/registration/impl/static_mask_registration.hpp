@@ -190,6 +190,20 @@ StaticMaskRegistration<PointT>::setInputSource(const PointCloudConstPtr& cloud,
 }
 
 template <typename PointT>
+void
+StaticMaskRegistration<PointT>::precomputeTarget()
+{
+  if (params_.backend != RegistrationBackend::direct || !target_ ||
+      !target_->isOrganized() || target_cells_.image_width != target_->width ||
+      target_cells_.image_height != target_->height ||
+      target_cells_.labels.size() != target_cells_.size() ||
+      target_cells_.cell_size == 0)
+    return;
+  directFrameOf(target_, source_)
+      .samples(target_cells_, intrinsics_, params_.rgbd_max_depth);
+}
+
+template <typename PointT>
 StaticMaskRegistrationStatus
 StaticMaskRegistration<PointT>::alignDirect(const Eigen::Matrix4f& guess,
                                             Eigen::Matrix4f& T_prev_curr)
