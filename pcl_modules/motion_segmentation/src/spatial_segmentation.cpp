@@ -96,14 +96,15 @@ ResidualThresholds::of(const RigidMotionSegmentationParameters& params)
 {
   if (params.residual_model == ResidualModel::paper)
     return {params.inlier_threshold, params.entropy_lambda, params.dbscan_epsilon};
-  return {params.inlier_chi2, params.sensor_entropy_lambda, params.sensor_dbscan_epsilon};
+  return {params.inlier_chi2, params.sensor_entropy_lambda,
+          params.sensor_dbscan_epsilon};
 }
 
 double
 motionFieldDistance(const MotionHypothesis& x,
                     const MotionHypothesis& y,
-                    const std::vector<Eigen::Vector3f>& a,
-                    const std::vector<Eigen::Matrix3f>& information)
+                    const std::vector<Eigen::Vector3d>& a,
+                    const std::vector<Eigen::Matrix3d>& information)
 {
   const Eigen::Matrix3d dR =
       x.T_curr_prev.topLeftCorner<3, 3>() - y.T_curr_prev.topLeftCorner<3, 3>();
@@ -112,9 +113,8 @@ motionFieldDistance(const MotionHypothesis& x,
   double sum = 0.0;
   std::size_t n = 0;
   const auto add = [&](int i) {
-    const Eigen::Vector3d d = dR * a[i].cast<double>() + dt;
-    sum += information.empty() ? d.squaredNorm()
-                               : d.dot(information[i].cast<double>() * d);
+    const Eigen::Vector3d d = dR * a[i] + dt;
+    sum += information.empty() ? d.squaredNorm() : d.dot(information[i] * d);
     ++n;
   };
   // Merge of the two ascending inlier lists: every index of the union once.
@@ -218,9 +218,18 @@ SpatialSegmenter::clusterHypotheses(
 {
   const int h = static_cast<int>(accepted_.size());
   std::vector<double> distances(static_cast<std::size_t>(h) * h, 0.0);
+  // Converted once for the h (h - 1) / 2 pairs (exact: every float is a double).
+  std::vector<Eigen::Vector3d> a(a_.size());
+  std::transform(a_.begin(), a_.end(), a.begin(), [](const Eigen::Vector3f& p) {
+    return p.cast<double>();
+  });
+  std::vector<Eigen::Matrix3d> w(w_.size());
+  std::transform(w_.begin(), w_.end(), w.begin(), [](const Eigen::Matrix3f& m) {
+    return m.cast<double>();
+  });
   for (int i = 0; i < h; ++i)
     for (int j = i + 1; j < h; ++j) {
-      const double d = motionFieldDistance(accepted_[i], accepted_[j], a_, w_);
+      const double d = motionFieldDistance(accepted_[i], accepted_[j], a, w);
       distances[static_cast<std::size_t>(i) * h + j] = d;
       distances[static_cast<std::size_t>(j) * h + i] = d;
     }
@@ -355,9 +364,8 @@ SpatialSegmenter::segment(const GridFlowData& grid,
     double sum = 0.0;
     for (std::size_t k = 0; k < n; ++k) {
       min_errors_[k] = std::min(min_errors_[k], errors_[k]);
-      entropy_[k] =
-          1.0 - std::exp(-static_cast<double>(params.entropy_delta) -
-                         static_cast<double>(th_.lambda) * min_errors_[k]);
+      entropy_[k] = 1.0 - std::exp(-static_cast<double>(params.entropy_delta) -
+                                   static_cast<double>(th_.lambda) * min_errors_[k]);
       sum += entropy_[k];
     }
     accepted_.push_back(hypothesis);

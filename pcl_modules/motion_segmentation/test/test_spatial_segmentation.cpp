@@ -184,7 +184,7 @@ TEST(SpatialSegmentation, SameSeedSameResult)
 TEST(SpatialSegmentation, MotionFieldDistanceOfTwoTranslations)
 {
   // Two pure translations 4 mm apart move every point 4 mm apart.
-  const std::vector<Eigen::Vector3f> a = {{0, 0, 1}, {1, 0, 2}, {0, 1, 3}};
+  const std::vector<Eigen::Vector3d> a = {{0, 0, 1}, {1, 0, 2}, {0, 1, 3}};
   dynvo::MotionHypothesis x, y;
   x.T_curr_prev = makeMotion({0, 0, 1}, 0.0, {0.01, 0.0, 0.0});
   y.T_curr_prev = makeMotion({0, 0, 1}, 0.0, {0.01, 0.004, 0.0});
