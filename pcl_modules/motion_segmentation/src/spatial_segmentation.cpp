@@ -96,8 +96,7 @@ ResidualThresholds::of(const RigidMotionSegmentationParameters& params)
 {
   if (params.residual_model == ResidualModel::paper)
     return {params.inlier_threshold, params.entropy_lambda, params.dbscan_epsilon};
-  return {params.inlier_chi2, params.sensor_entropy_lambda,
-          params.sensor_dbscan_epsilon};
+  return {params.inlier_chi2, params.sensor_entropy_lambda, params.sensor_dbscan_epsilon};
 }
 
 double
@@ -364,8 +363,9 @@ SpatialSegmenter::segment(const GridFlowData& grid,
     double sum = 0.0;
     for (std::size_t k = 0; k < n; ++k) {
       min_errors_[k] = std::min(min_errors_[k], errors_[k]);
-      entropy_[k] = 1.0 - std::exp(-static_cast<double>(params.entropy_delta) -
-                                   static_cast<double>(th_.lambda) * min_errors_[k]);
+      entropy_[k] =
+          1.0 - std::exp(-static_cast<double>(params.entropy_delta) -
+                         static_cast<double>(th_.lambda) * min_errors_[k]);
       sum += entropy_[k];
     }
     accepted_.push_back(hypothesis);

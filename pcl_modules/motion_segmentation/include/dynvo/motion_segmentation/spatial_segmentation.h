@@ -28,8 +28,8 @@ struct SpatialSegmentationResult {
       motions;            ///< H_c (T_curr_prev) of segment c at index c - 1
   std::vector<int> sizes; ///< N_c, cells of segment c at index c - 1
   std::vector<MotionHypothesis>
-      hypotheses;                ///< accepted hypotheses, inliers as cell indices
-  int trials = 0;                ///< trials made, failed ones included
+      hypotheses; ///< accepted hypotheses, inliers as cell indices
+  int trials = 0; ///< trials made, failed ones included
   float inlier_threshold = 0.0f; ///< th of this result, in the unit of E_i
 
   /// Number of segments g.
@@ -58,11 +58,10 @@ dbscan(const std::vector<double>& distances, int count, double epsilon, int min_
  *            is in sigma), or empty for W_i = I (the paper's distance in metres)
  * Both in double: every pair of hypotheses reads them again, so the caller converts once.
  */
-DYNVO_EXPORTS double
-motionFieldDistance(const MotionHypothesis& x,
-                    const MotionHypothesis& y,
-                    const std::vector<Eigen::Vector3d>& a,
-                    const std::vector<Eigen::Matrix3d>& information);
+DYNVO_EXPORTS double motionFieldDistance(const MotionHypothesis& x,
+                                         const MotionHypothesis& y,
+                                         const std::vector<Eigen::Vector3d>& a,
+                                         const std::vector<Eigen::Matrix3d>& information);
 
 /// The three thresholds of the search in the unit of E_i (docs/algorithm.md §2).
 struct DYNVO_EXPORTS ResidualThresholds {
@@ -123,17 +122,13 @@ private:
   std::vector<Eigen::Vector3f> a_;  ///< packed a_i
   std::vector<Eigen::Vector3f> b_;  ///< packed b_i
   std::vector<Eigen::Matrix3f> w_;  ///< packed W_i, empty for the paper model
-  std::vector<Eigen::Vector3d>
-      a_double_; ///< a_ in double, for the hypotheses' distances
-  std::vector<Eigen::Matrix3d>
-      w_double_;                  ///< w_ in double, for the hypotheses' distances
-  ResidualThresholds th_;         ///< thresholds of this call
-  std::vector<float> errors_;     ///< E_k of the hypothesis being evaluated
-  std::vector<float> min_errors_; ///< min over accepted hypotheses of E_k
-  std::vector<double> entropy_;   ///< S_k
-  std::vector<int> candidates_;   ///< neighbours of the current seed
-  std::vector<int> sample_;       ///< the m sampled points
-  std::vector<int> inliers_;      ///< inlier scratch
+  ResidualThresholds th_;           ///< thresholds of this call
+  std::vector<float> errors_;       ///< E_k of the hypothesis being evaluated
+  std::vector<float> min_errors_;   ///< min over accepted hypotheses of E_k
+  std::vector<double> entropy_;     ///< S_k
+  std::vector<int> candidates_;     ///< neighbours of the current seed
+  std::vector<int> sample_;         ///< the m sampled points
+  std::vector<int> inliers_;        ///< inlier scratch
   std::vector<MotionHypothesis>
       accepted_; ///< hypotheses of this frame (packed indices)
   using Draw = std::discrete_distribution<int>;

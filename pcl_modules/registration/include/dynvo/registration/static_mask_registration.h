@@ -156,6 +156,9 @@ private:
   /// Stores checked parameters.
   void assignParameters(const Parameters& parameters) { params_ = parameters; }
 
+  /// The cells are a grid over the cloud's image.
+  static bool covers(const FlowGrid& cells, const PointCloud& cloud);
+
   /// Non-null organized clouds of equal size, masks on grids over them; logs PCL_ERROR.
   bool validateInputs() const;
 

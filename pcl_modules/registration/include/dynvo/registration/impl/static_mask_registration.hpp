@@ -56,6 +56,14 @@ maskedLatticePoints(const pcl::PointCloud<PointT>& cloud,
 
 template <typename PointT>
 bool
+StaticMaskRegistration<PointT>::covers(const FlowGrid& cells, const PointCloud& cloud)
+{
+  return cells.cell_size > 0 && cells.image_width == cloud.width &&
+         cells.image_height == cloud.height && cells.labels.size() == cells.size();
+}
+
+template <typename PointT>
+bool
 StaticMaskRegistration<PointT>::validateInputs() const
 {
   const auto fail = [this](const char* problem) {
@@ -68,11 +76,7 @@ StaticMaskRegistration<PointT>::validateInputs() const
     return fail("source and target must be organized clouds");
   if (source_->width != target_->width || source_->height != target_->height)
     return fail("source and target must have the same size");
-  const auto covers = [this](const FlowGrid& cells) {
-    return cells.cell_size > 0 && cells.image_width == source_->width &&
-           cells.image_height == source_->height && cells.labels.size() == cells.size();
-  };
-  if (!covers(source_cells_) || !covers(target_cells_))
+  if (!covers(source_cells_, *source_) || !covers(target_cells_, *source_))
     return fail(
         "the static cells of both frames must be grids over the clouds' images");
   return true;
@@ -194,10 +198,7 @@ void
 StaticMaskRegistration<PointT>::precomputeTarget()
 {
   if (params_.backend != RegistrationBackend::direct || !target_ ||
-      !target_->isOrganized() || target_cells_.image_width != target_->width ||
-      target_cells_.image_height != target_->height ||
-      target_cells_.labels.size() != target_cells_.size() ||
-      target_cells_.cell_size == 0)
+      !target_->isOrganized() || !covers(target_cells_, *target_))
     return;
   directFrameOf(target_, source_)
       .samples(target_cells_, intrinsics_, params_.rgbd_max_depth);
