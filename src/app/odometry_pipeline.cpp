@@ -324,7 +324,16 @@ struct OdometryPipeline::Impl {
               frames, segmentation.hasBackground() ? "a" : "still no");
     result.segment_labels = segmentation.getSegmentLabels();
     result.motions = segmentation.getMotions();
+    paintLabels();
     result.times.segmentation_ms += millisecondsSince(start);
+  }
+
+  /// result.labels from result.segments and result.segment_labels.
+  void paintLabels()
+  {
+    result.labels = paintLabelImage(result.segments, result.segment_labels,
+                                    result.width, result.height)
+                        .data;
   }
 
   /** The backend's inputs that do not depend on this frame's fits: the direct backend's
@@ -350,8 +359,8 @@ struct OdometryPipeline::Impl {
                                             : std::async(std::launch::deferred, inputs);
   }
 
-  /** The segmentation's pixel stage (pixel labels and indices): nothing the fits do depends
-   * on it (they take cells), so with a second thread it runs beside them until
+  /** The segmentation's pixel stage (pixel labels, indices, the label image): nothing the
+   * fits do depends on it (they take cells), so with a second thread it runs beside them until
    * finishSegments(). Its time counts in segmentation_ms, so with two threads the stages can
    * add up to more than the frame's total.
    */
@@ -360,6 +369,7 @@ struct OdometryPipeline::Impl {
     const auto pixel_stage = [this] {
       const auto start = Clock::now();
       segmentation.computeSegments(result.segments);
+      paintLabels();
       return millisecondsSince(start);
     };
     segments_ms = options.threads > 1 ? std::async(std::launch::async, pixel_stage)
@@ -680,9 +690,10 @@ OdometryPipeline::process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& clo
     if (p.options.use_segmentation && !result.lost)
       p.evidence.update(*p.frame_flow, rigidInverse(result.T_curr_prev));
   }
-  result.labels = paintLabelImage(result.segments, result.segment_labels, result.width,
-                                  result.height)
-                      .data;
+  // The pixel stage paints the labels with its segments (on the second thread when there is
+  // one); the first frame and a run without segmentation have none.
+  if (result.labels.empty())
+    p.paintLabels();
   // The chain stays at the depth instants; the reported pose moves to the colour stamp.
   const Eigen::Matrix4d T_world_depth = result.T_world_curr;
   if (p.frames > 0 && depth_stamp != timestamp &&

@@ -178,6 +178,18 @@ GridFlowEngine::GridFlowEngine()
 GridFlowEngine::~GridFlowEngine() = default;
 
 void
+GridFlowEngine::forEachStripe(std::size_t n,
+                              unsigned threads,
+                              const std::function<void(std::size_t, std::size_t)>& body)
+{
+  const auto stripes = static_cast<unsigned>(std::min<std::size_t>(threads, n));
+  runStripes(stripes, [&](unsigned s) {
+    const auto [begin, end] = stripeRange(n, stripes, s);
+    body(begin, end);
+  });
+}
+
+void
 GridFlowEngine::prepare(Slot slot,
                         const std::vector<std::uint8_t>& grey,
                         const std::vector<float>& depth,
@@ -384,13 +396,18 @@ GridFlowEngine::track(const Frame& reference,
                                   params.max_iterations, params.epsilon);
   const float fb2 =
       params.forward_backward_threshold * params.forward_backward_threshold;
+  // Stripe s takes every stripes-th cell from the s-th: the stripes cover the whole image
+  // alike, so their cost is even (contiguous stripes are not: the top and bottom of an image
+  // differ in texture). Each point is tracked on its own: the same flow for any split.
   const unsigned stripes = static_cast<unsigned>(std::min<std::size_t>(threads, m));
   runStripes(stripes, [&](unsigned s) {
-    const auto [begin, end] = stripeRange(m, stripes, s);
-    std::vector<cv::Point2f> from;
-    for (std::size_t k = begin; k < end; ++k)
+    std::vector<std::size_t> cells;
+    std::vector<cv::Point2f> from, to;
+    for (std::size_t k = s; k < m; k += stripes) {
+      cells.push_back(tracked_cells[k]);
       from.push_back(centres[tracked_cells[k]]);
-    std::vector<cv::Point2f> to(seeds.begin() + begin, seeds.begin() + end);
+      to.push_back(seeds[k]);
+    }
     std::vector<std::uint8_t> status;
     cv::calcOpticalFlowPyrLK(curr.pyramid, prev.pyramid, from, to, status,
                              cv::noArray(), window, max_level, criteria,
@@ -398,7 +415,7 @@ GridFlowEngine::track(const Frame& reference,
     std::vector<cv::Point2f> forward;
     std::vector<std::size_t> index;
     for (std::size_t k = 0; k < from.size(); ++k) {
-      const std::size_t i = tracked_cells[begin + k];
+      const std::size_t i = cells[k];
       tracked[i] = to[k];
       const cv::Point2f& p = to[k];
       if (status[k] && inside(p)) {
@@ -508,10 +525,7 @@ GridFlowEngine::track(const Frame& reference,
     f.weight = std::min(1.0f, ratio * ratio * ratio * ratio);
   };
   // Cells are independent: stripes of cells, the same flow for any thread count.
-  const unsigned cell_stripes =
-      static_cast<unsigned>(std::min<std::size_t>(threads, n));
-  runStripes(cell_stripes, [&](unsigned s) {
-    const auto [begin, end] = stripeRange(n, cell_stripes, s);
+  forEachStripe(n, threads, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i)
       finish_cell(i);
   });

@@ -147,11 +147,14 @@ GridSceneFlowEstimation<PointT>::prepareFrame(
   const std::size_t size = cloud.size();
   grey.resize(size);
   depth.resize(size);
-  for (std::size_t i = 0; i < size; ++i) {
-    const PointT& p = cloud[i];
-    grey[i] = luma(p.r, p.g, p.b);
-    depth[i] = std::isfinite(p.z) ? p.z : std::numeric_limits<float>::quiet_NaN();
-  }
+  detail::GridFlowEngine::forEachStripe(
+      size, threads_, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) {
+          const PointT& p = cloud[i];
+          grey[i] = luma(p.r, p.g, p.b);
+          depth[i] = std::isfinite(p.z) ? p.z : std::numeric_limits<float>::quiet_NaN();
+        }
+      });
   engine_.prepare(slot, grey, depth, cloud.width, cloud.height, params_, threads_,
                   stamps);
 }
