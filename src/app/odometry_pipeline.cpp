@@ -328,12 +328,17 @@ struct OdometryPipeline::Impl {
     result.times.segmentation_ms += millisecondsSince(start);
   }
 
-  /// result.labels from result.segments and result.segment_labels.
+  /// result.labels: the segmentation's pixel labels when it made them for this frame, else
+  /// painted from result.segments (the first frame's start-up segment, or none).
   void paintLabels()
   {
-    result.labels = paintLabelImage(result.segments, result.segment_labels,
-                                    result.width, result.height)
-                        .data;
+    const std::vector<std::uint8_t>& pixels = segmentation.getPixelLabels();
+    result.labels = options.use_segmentation && frames > 0 &&
+                            pixels.size() == std::size_t{result.width} * result.height
+                        ? pixels
+                        : paintLabelImage(result.segments, result.segment_labels,
+                                          result.width, result.height)
+                              .data;
   }
 
   /** The backend's inputs that do not depend on this frame's fits: the direct backend's
