@@ -176,6 +176,7 @@ struct OdometryPipeline::Impl {
     noise_tracker.setUpperBound(options.segmentation.inlier_threshold);
     backend.setParameters(options.backend);
     backend.setCameraIntrinsics(options.intrinsics);
+    backend.setNumberOfThreads(options.threads);
     StaticMaskRegistrationParameters dense = options.backend;
     dense.backend = RegistrationBackend::cv_rgbd;
     recovery.setParameters(dense);

@@ -43,7 +43,8 @@ greyDepths()
 /// The direct step (docs/algorithm.md §7.7) per frame as the pipeline runs it: the frame's
 /// pyramids, the previous frame's samples, then two alignments to it (the step and its refit
 /// on the keyframe fit's cells), every cell static. The guess is the identity (fr1/xyz moves
-/// 1-4 px per frame here), where the pipeline starts from the flow's estimate.
+/// 1-4 px per frame here), where the pipeline starts from the flow's estimate. Arg: threads
+/// of the alignments' residuals.
 void
 BM_DirectOdometryPerFrame(benchmark::State& state)
 {
@@ -51,6 +52,7 @@ BM_DirectOdometryPerFrame(benchmark::State& state)
     return;
   const dynvo::CameraIntrinsics intrinsics = dynvo::CameraIntrinsics::fromPreset("fr1");
   const dynvo::StaticMaskRegistrationParameters parameters;
+  const auto threads = static_cast<unsigned>(state.range(0));
   const auto width = frames()[0].cloud->width, height = frames()[0].cloud->height;
   dynvo::FlowGrid cells(width, height, 16);
   cells.labels.assign(cells.size(), dynvo::LABEL_STATIC);
@@ -71,7 +73,8 @@ BM_DirectOdometryPerFrame(benchmark::State& state)
     Eigen::Matrix4f guess = Eigen::Matrix4f::Identity(), T;
     for (int fit = 0; fit < 2; ++fit) {
       if (dynvo::detail::estimateDirectOdometry(*current, cells, *previous, cells,
-                                                intrinsics, parameters, guess, T))
+                                                intrinsics, parameters, guess, threads,
+                                                T))
         guess = T;
       else
         ++failed;
@@ -82,6 +85,11 @@ BM_DirectOdometryPerFrame(benchmark::State& state)
   if (failed > 0)
     state.SkipWithError("an alignment failed");
 }
-BENCHMARK(BM_DirectOdometryPerFrame)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_DirectOdometryPerFrame)
+    ->ArgName("threads")
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 } // namespace

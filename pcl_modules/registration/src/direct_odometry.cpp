@@ -32,6 +32,8 @@ constexpr float MIN_GRADIENT = 6.0f;
 constexpr int FINE_STEP = 2;
 /// Fewer residuals on a level: the alignment fails.
 constexpr std::size_t MIN_RESIDUALS = 100;
+/// Fewer samples are not worth a second thread: waking it costs about as much as their pass.
+constexpr std::size_t MIN_PARALLEL_SAMPLES = 500;
 /// Metres and radians: a smaller step ends the level.
 constexpr float CONVERGED = 1e-5f;
 
@@ -281,6 +283,7 @@ estimateDirectOdometry(const DirectFrame& source,
                        const CameraIntrinsics& intrinsics,
                        const StaticMaskRegistrationParameters& parameters,
                        const Eigen::Matrix4f& guess,
+                       unsigned threads,
                        Eigen::Matrix4f& T_target_source)
 {
   Eigen::Isometry3f T(Eigen::Isometry3f(guess).inverse()); // T_source_target
@@ -321,9 +324,18 @@ estimateDirectOdometry(const DirectFrame& source,
           return none;
         return bilinear(s.grey, u, v) - sample.intensity - offset;
       };
-      // Each sample's residual under T, once per step; NaN where it has none.
-      for (std::size_t i = 0; i < samples.size(); ++i)
-        residuals[i] = residualOf(samples[i]);
+      // Each sample's residual under T, once per step; NaN where it has none. Samples are
+      // independent: stripes of them give the same residuals for any thread count (the sums
+      // below stay in sample order).
+      const auto residualsOf = [&](const cv::Range& range) {
+        for (int i = range.start; i < range.end; ++i)
+          residuals[i] = residualOf(samples[i]);
+      };
+      const cv::Range all(0, static_cast<int>(samples.size()));
+      if (threads > 1 && samples.size() >= MIN_PARALLEL_SAMPLES)
+        cv::parallel_for_(all, residualsOf, static_cast<double>(threads));
+      else
+        residualsOf(all);
       if (iteration == 0) { // Tukey's threshold of the level: 4.685 robust sigmas
         magnitudes.clear();
         for (const float r : residuals)

@@ -72,6 +72,7 @@ private:
  * \param[in] parameters rgbd_max_depth (farther target pixels are not used) and
  *            rgbd_max_depth_difference (a pixel whose source depth differs more is occluded)
  * \param[in] guess initial T_target_source (metres)
+ * \param[in] threads worker threads of the residuals (>= 1; the same estimate for any count)
  * \param[out] T_target_source the estimate; written only on success
  * \return false when a level has fewer than 100 usable pixels or the system is singular
  */
@@ -83,6 +84,7 @@ estimateDirectOdometry(const DirectFrame& source,
                        const CameraIntrinsics& intrinsics,
                        const StaticMaskRegistrationParameters& parameters,
                        const Eigen::Matrix4f& guess,
+                       unsigned threads,
                        Eigen::Matrix4f& T_target_source);
 
 } // namespace dynvo::detail

@@ -108,6 +108,20 @@ public:
 
   const CameraIntrinsics& getCameraIntrinsics() const { return intrinsics_; }
 
+  /** \brief Worker threads (default 1) of the direct backend's residuals; results are
+   * identical for any count. \throws std::invalid_argument on 0
+   */
+  void setNumberOfThreads(unsigned threads)
+  {
+    if (threads == 0)
+      throw std::invalid_argument(
+          "[dynvo::" + class_name_ +
+          "::setNumberOfThreads] at least one thread is needed");
+    threads_ = threads;
+  }
+
+  unsigned getNumberOfThreads() const { return threads_; }
+
   /// Frame k (organized, metres). With the direct backend its pyramids are built here, once
   /// per cloud (set it while the cloud is still in the cache).
   void setInputSource(const PointCloudConstPtr& cloud)
@@ -191,6 +205,7 @@ private:
   std::string class_name_ = "StaticMaskRegistration"; ///< log prefix
   Parameters params_;                                 ///< validated knobs
   CameraIntrinsics intrinsics_;                       ///< of both frames
+  unsigned threads_ = 1;                              ///< worker threads (direct)
   PointCloudConstPtr source_;                         ///< frame k
   PointCloudConstPtr target_;                         ///< frame k-1
   FlowGrid source_cells_;                             ///< static cells of frame k

@@ -219,7 +219,8 @@ StaticMaskRegistration<PointT>::alignDirect(const Eigen::Matrix4f& guess,
   const detail::DirectFrame& source = directFrameOf(source_, target_);
   const detail::DirectFrame& target = directFrameOf(target_, source_);
   return detail::estimateDirectOdometry(source, source_cells_, target, target_cells_,
-                                        intrinsics_, params_, guess, T_prev_curr)
+                                        intrinsics_, params_, guess, threads_,
+                                        T_prev_curr)
              ? Status::converged
              : Status::not_converged;
 }
