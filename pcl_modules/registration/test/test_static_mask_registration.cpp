@@ -280,6 +280,31 @@ TEST_F(StaticMaskRegistrationTest, DirectTargetPrecomputedGivesTheSameEstimate)
   EXPECT_EQ(estimate(true), chosen_in_align);
 }
 
+TEST_F(StaticMaskRegistrationTest, DirectEstimateIsIdenticalForOneAndTwoThreads)
+{
+  // The residuals are computed in stripes, the sums in sample order: the thread count must
+  // not change a single bit of the estimate.
+  const auto estimate = [&](unsigned threads) {
+    dynvo::StaticMaskRegistration<Point> backend;
+    backend.setBackend(RegistrationBackend::direct);
+    backend.setCameraIntrinsics(scene_.intrinsics);
+    backend.setNumberOfThreads(threads);
+    backend.setInputSource(pair_.current.cloud);
+    backend.setInputTarget(pair_.previous.cloud);
+    backend.setSourceStaticCells(staticCellsOf(pair_.current, scene_, pair_.grid));
+    backend.setTargetStaticCells(staticCellsOf(pair_.previous, scene_, pair_.grid));
+    Eigen::Matrix4f result = Eigen::Matrix4f::Zero();
+    EXPECT_TRUE(backend.align(guess(), result));
+    return result;
+  };
+  const Eigen::Matrix4f one = estimate(1);
+  EXPECT_LT(translationError(one, truth()), 2e-3);
+  EXPECT_EQ(estimate(2), one);
+  EXPECT_EQ(estimate(3), one);
+  EXPECT_THROW(backend_.setNumberOfThreads(0), std::invalid_argument);
+  EXPECT_EQ(backend_.getNumberOfThreads(), 1u);
+}
+
 TEST_F(StaticMaskRegistrationTest, BrokenInputIsReportedAndLeavesTheGuess)
 {
   backend_.setBackend(RegistrationBackend::cv_rgbd);
