@@ -3,6 +3,8 @@
 // §7.7): inverse compositional Gauss-Newton on textured target pixels, coarse to fine.
 #include <dynvo/registration/direct_odometry.h>
 
+#include <dynvo/common/parallel.h>
+
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -327,15 +329,12 @@ estimateDirectOdometry(const DirectFrame& source,
       // Each sample's residual under T, once per step; NaN where it has none. Samples are
       // independent: stripes of them give the same residuals for any thread count (the sums
       // below stay in sample order).
-      const auto residualsOf = [&](const cv::Range& range) {
-        for (int i = range.start; i < range.end; ++i)
-          residuals[i] = residualOf(samples[i]);
-      };
-      const cv::Range all(0, static_cast<int>(samples.size()));
-      if (threads > 1 && samples.size() >= MIN_PARALLEL_SAMPLES)
-        cv::parallel_for_(all, residualsOf, static_cast<double>(threads));
-      else
-        residualsOf(all);
+      forEachStripe(samples.size(),
+                    samples.size() >= MIN_PARALLEL_SAMPLES ? threads : 1,
+                    [&](std::size_t begin, std::size_t end) {
+                      for (std::size_t i = begin; i < end; ++i)
+                        residuals[i] = residualOf(samples[i]);
+                    });
       if (iteration == 0) { // Tukey's threshold of the level: 4.685 robust sigmas
         magnitudes.clear();
         for (const float r : residuals)

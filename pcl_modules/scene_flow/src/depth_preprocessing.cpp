@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <dynvo/scene_flow/depth_preprocessing.h>
 
-#include "parallel_stripes.h"
+#include <dynvo/common/parallel.h>
 
 #include <algorithm>
 #include <cmath>
@@ -143,8 +143,7 @@ DepthPreprocessing::apply(const std::vector<float>& depth,
           n[count++] = in_range(depth[yy * w + xx]);
     out[y * w + x] = keep(in_range(depth[y * w + x]), n, count);
   };
-  detail::runStripes(threads_, [&](unsigned s) {
-    const auto [row_begin, row_end] = detail::stripeRange(h, threads_, s);
+  forEachStripe(h, threads_, [&](std::size_t row_begin, std::size_t row_end) {
     // The in-range depths of rows y - 1, y and y + 1, in a ring of three rows.
     std::vector<float> ring(3 * w);
     const auto row_in_range = [&](std::size_t y) {
@@ -183,8 +182,7 @@ DepthPreprocessing::apply(const std::vector<float>& depth,
     return;
   const float tau_fill = params_.hole_fill_tolerance;
   // Row pass: each row is its own line.
-  detail::runStripes(threads_, [&](unsigned s) {
-    const auto [row_begin, row_end] = detail::stripeRange(h, threads_, s);
+  forEachStripe(h, threads_, [&](std::size_t row_begin, std::size_t row_end) {
     for (std::size_t y = row_begin; y < row_end; ++y) {
       float* line = out.data() + y * w;
       std::size_t last = w; // no valid pixel seen yet
@@ -203,8 +201,7 @@ DepthPreprocessing::apply(const std::vector<float>& depth,
   // row first marks the columns that close a gap (branch-free, vectorised), then fills those.
   // (A gap is shorter than h.)
   const int max_gap_rows = static_cast<int>(std::min(max_gap, h));
-  detail::runStripes(threads_, [&](unsigned s) {
-    const auto [col_begin, col_end] = detail::stripeRange(w, threads_, s);
+  forEachStripe(w, threads_, [&](std::size_t col_begin, std::size_t col_end) {
     const std::size_t cols = col_end - col_begin;
     // The last valid row of each column; before the first, one that makes any gap too wide.
     std::vector<int> last(cols, -max_gap_rows - 2);

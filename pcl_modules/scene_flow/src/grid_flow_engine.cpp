@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <dynvo/scene_flow/grid_flow_engine.h>
 
+#include <dynvo/common/parallel.h>
+
 #include "parallel_stripes.h"
 
 #include <opencv2/core.hpp>
@@ -176,18 +178,6 @@ GridFlowEngine::GridFlowEngine()
 }
 
 GridFlowEngine::~GridFlowEngine() = default;
-
-void
-GridFlowEngine::forEachStripe(std::size_t n,
-                              unsigned threads,
-                              const std::function<void(std::size_t, std::size_t)>& body)
-{
-  const auto stripes = static_cast<unsigned>(std::min<std::size_t>(threads, n));
-  runStripes(stripes, [&](unsigned s) {
-    const auto [begin, end] = stripeRange(n, stripes, s);
-    body(begin, end);
-  });
-}
 
 void
 GridFlowEngine::prepare(Slot slot,

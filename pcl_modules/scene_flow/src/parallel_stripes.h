@@ -1,22 +1,18 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Explicit thread counts on top of cv::parallel_for_ (private to dynvo_scene_flow).
+// Stripe-indexed work on an explicit thread count (private to dynvo_scene_flow).
 #pragma once
 
 #include <opencv2/core/utility.hpp>
-
-#include <cstddef>
-#include <utility>
 
 namespace dynvo::detail {
 
 /** \brief Runs body(s) for every stripe s in [0, stripes) on at most `stripes` threads.
  *
- * cv::setNumThreads() is process-wide, so the thread count is passed here instead: the stripes
- * go through cv::parallel_for_, and OpenCV runs any parallel_for_ nested inside a running one
- * serially (OpenCV 4.x, core/src/parallel.cpp). OpenCV calls made by body (LK, pyramids) thus
- * stay on the stripe's own thread, and with stripes == 1 everything runs on the caller's thread.
- * Side effect: while a stripe region runs, OpenCV calls from other threads of the process run
- * serially too. The pool is OpenCV's, so fewer threads are used when cv::getNumThreads() is lower.
+ * For work that a stripe chooses by its index (one task per stripe, or items dealt to the
+ * stripes in turn); contiguous ranges of items take dynvo::forEachStripe()
+ * (dynvo/common/parallel.h), whose rules hold here too: the stripes go through
+ * cv::parallel_for_, so OpenCV calls made by body (LK, pyramids) stay on the stripe's own
+ * thread, and with stripes == 1 everything runs on the caller's thread.
  */
 template <typename Body>
 void
@@ -29,13 +25,6 @@ runStripes(unsigned stripes, const Body& body)
           body(static_cast<unsigned>(s));
       },
       static_cast<double>(stripes));
-}
-
-/// Items [first, second) of stripe s when n items are cut into `stripes` contiguous parts.
-inline std::pair<std::size_t, std::size_t>
-stripeRange(std::size_t n, unsigned stripes, unsigned s)
-{
-  return {n * s / stripes, n * (s + 1) / stripes};
 }
 
 } // namespace dynvo::detail

@@ -11,9 +11,7 @@
 
 #include <Eigen/Core>
 
-#include <cstddef>
 #include <cstdint>
-#include <functional>
 #include <limits>
 #include <memory>
 #include <vector>
@@ -40,13 +38,6 @@ public:
   ~GridFlowEngine();
   GridFlowEngine(const GridFlowEngine&) = delete;
   GridFlowEngine& operator=(const GridFlowEngine&) = delete;
-
-  /** \brief Runs body(begin, end) on the items [0, n) cut into min(threads, n) contiguous
-   * stripes, each on its own thread (threads == 1: on the caller's).
-   */
-  static void forEachStripe(std::size_t n,
-                            unsigned threads,
-                            const std::function<void(std::size_t, std::size_t)>& body);
 
   /** \brief Preprocess a frame's depth and build its pyramid into a slot.
    * \param[in] grey width * height grey levels, row-major

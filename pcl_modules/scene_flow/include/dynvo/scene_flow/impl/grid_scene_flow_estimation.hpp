@@ -3,6 +3,7 @@
 #pragma once
 
 #include <dynvo/common/image.h>
+#include <dynvo/common/parallel.h>
 #include <dynvo/common/flow_grid.h>
 #include <dynvo/common/rigid_fit.h>
 #include <dynvo/scene_flow/grid_scene_flow_estimation.h>
@@ -147,14 +148,13 @@ GridSceneFlowEstimation<PointT>::prepareFrame(
   const std::size_t size = cloud.size();
   grey.resize(size);
   depth.resize(size);
-  detail::GridFlowEngine::forEachStripe(
-      size, threads_, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t i = begin; i < end; ++i) {
-          const PointT& p = cloud[i];
-          grey[i] = luma(p.r, p.g, p.b);
-          depth[i] = std::isfinite(p.z) ? p.z : std::numeric_limits<float>::quiet_NaN();
-        }
-      });
+  forEachStripe(size, threads_, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const PointT& p = cloud[i];
+      grey[i] = luma(p.r, p.g, p.b);
+      depth[i] = std::isfinite(p.z) ? p.z : std::numeric_limits<float>::quiet_NaN();
+    }
+  });
   engine_.prepare(slot, grey, depth, cloud.width, cloud.height, params_, threads_,
                   stamps);
 }
