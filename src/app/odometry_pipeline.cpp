@@ -325,13 +325,13 @@ struct OdometryPipeline::Impl {
               frames, segmentation.hasBackground() ? "a" : "still no");
     result.segment_labels = segmentation.getSegmentLabels();
     result.motions = segmentation.getMotions();
-    paintLabels();
+    makeLabelImage();
     result.times.segmentation_ms += millisecondsSince(start);
   }
 
   /// result.labels: the segmentation's pixel labels when it made them for this frame, else
   /// painted from result.segments (the first frame's start-up segment, or none).
-  void paintLabels()
+  void makeLabelImage()
   {
     const std::vector<std::uint8_t>& pixels = segmentation.getPixelLabels();
     result.labels = options.use_segmentation && frames > 0 &&
@@ -375,7 +375,7 @@ struct OdometryPipeline::Impl {
     const auto pixel_stage = [this] {
       const auto start = Clock::now();
       segmentation.computeSegments(result.segments);
-      paintLabels();
+      makeLabelImage();
       return millisecondsSince(start);
     };
     segments_ms = options.threads > 1 ? std::async(std::launch::async, pixel_stage)
@@ -696,10 +696,10 @@ OdometryPipeline::process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& clo
     if (p.options.use_segmentation && !result.lost)
       p.evidence.update(*p.frame_flow, rigidInverse(result.T_curr_prev));
   }
-  // The pixel stage paints the labels with its segments (on the second thread when there is
-  // one); the first frame and a run without segmentation have none.
+  // The pixel stage makes the label image (on the second thread when there is one); the
+  // first frame and a run without segmentation have no pixel stage.
   if (result.labels.empty())
-    p.paintLabels();
+    p.makeLabelImage();
   // The chain stays at the depth instants; the reported pose moves to the colour stamp.
   const Eigen::Matrix4d T_world_depth = result.T_world_curr;
   if (p.frames > 0 && depth_stamp != timestamp &&
