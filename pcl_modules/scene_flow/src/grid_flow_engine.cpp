@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <deque>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -153,6 +154,38 @@ depthOffset(const GridFlowEngine::FrameStamps& stamps)
 {
   const double offset = stamps.depth - stamps.colour;
   return std::isfinite(offset) ? static_cast<float>(offset) : 0.0f;
+}
+
+/** Gives every cell of a cols x rows grid that is not `known` the value of its nearest known
+ * cell (breadth-first over 4-neighbours, so ties go to the first in grid order); nothing
+ * changes without a known cell.
+ */
+void
+fillFromNearest(std::vector<Eigen::Vector2f>& values,
+                std::vector<std::uint8_t> known,
+                int cols,
+                int rows)
+{
+  std::deque<std::size_t> queue;
+  for (std::size_t i = 0; i < known.size(); ++i)
+    if (known[i])
+      queue.push_back(i);
+  for (; !queue.empty(); queue.pop_front()) {
+    const std::size_t i = queue.front();
+    const int row = static_cast<int>(i) / cols, c = static_cast<int>(i) % cols;
+    const std::array<std::array<int, 2>, 4> neighbours{
+        {{row - 1, c}, {row + 1, c}, {row, c - 1}, {row, c + 1}}};
+    for (const auto& [nr, nc] : neighbours) {
+      if (nr < 0 || nr >= rows || nc < 0 || nc >= cols)
+        continue;
+      const std::size_t j = static_cast<std::size_t>(nr) * cols + nc;
+      if (known[j])
+        continue;
+      known[j] = 1;
+      values[j] = values[i];
+      queue.push_back(j);
+    }
+  }
 }
 
 } // namespace
@@ -435,16 +468,21 @@ GridFlowEngine::track(const Frame& reference,
   });
 
   // Each cell's image velocity (px/s): frame to frame, that of this track; to the keyframe,
-  // the one the current frame kept from its own frame-to-frame track (none: zero).
+  // the one the current frame kept from its own frame-to-frame track (none: zero). A cell
+  // without a track (LK or its check failed) takes its nearest tracked cell's: the image
+  // motion is smooth, and zero put the depth instants of the keyframe points falling in such
+  // a cell off by the velocity times the depth-colour offset (docs/algorithm.md §1.2).
   velocity.assign(n, Eigen::Vector2f::Zero());
   if (frame_to_frame) {
     const double dt = curr.stamps.colour - prev.stamps.colour;
-    if (dt > 0.0) // false when a stamp is unknown
+    if (dt > 0.0) { // false when a stamp is unknown
       for (std::size_t i = 0; i < n; ++i)
         if (valid2d[i])
           velocity[i] = Eigen::Vector2f(centres[i].x - tracked[i].x,
                                         centres[i].y - tracked[i].y) /
                         static_cast<float>(dt);
+      fillFromNearest(velocity, valid2d, cols, rows);
+    }
   }
   else if (curr.velocity.size() == n) {
     velocity = curr.velocity;
