@@ -89,9 +89,9 @@ SegmentTracker::warpNearest(const std::vector<std::uint8_t>& map,
   std::vector<std::uint8_t> warped(grid.size(), 0);
   const float half = static_cast<float>(grid.cellSize() / 2);
   for (std::size_t i = 0; i < grid.size(); ++i) {
-    if (!grid.valid_2d[i])
+    const Eigen::Vector2f& p = source_[i];
+    if (!p.allFinite())
       continue;
-    const Eigen::Vector2f& p = grid.previous_pixel[i];
     const long a = std::lround((p.x() - half) / grid.cellSize());
     const long b = std::lround((p.y() - half) / grid.cellSize());
     if (a >= 0 && a < grid.cols() && b >= 0 && b < grid.rows())
@@ -599,6 +599,8 @@ SegmentTracker::update(const GridFlowData& grid,
     model_.reset(grid.cols(), grid.rows(), params.max_labels);
   }
   collectUsedIds(params.max_labels);
+  // §6's source of every cell, also the one every map of the past is warped through.
+  sourcePixels(grid, T_pred, intrinsics);
   for (auto& map : buffer_)
     map = warpNearest(map, grid);
 
@@ -622,7 +624,6 @@ SegmentTracker::update(const GridFlowData& grid,
   keepObjectsApart(grid, spatial, ids, params);
 
   // §6 then §5: carry the models into the current grid, fold in Ghat, read out L.
-  sourcePixels(grid, T_pred, intrinsics);
   model_.compensate(source_, grid.valid_2d, grid.cellSize());
   model_.update(tracked_, params.max_age);
 

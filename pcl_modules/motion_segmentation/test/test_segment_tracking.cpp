@@ -305,7 +305,8 @@ setRegionFrame(dynvo::RigidMotionSegmentation<pcl::PointXYZRGB>& segmentation,
                const std::array<int, 4>& box,
                double step,
                std::size_t k,
-               bool box_measured = true)
+               bool box_measured = true,
+               bool box_tracked = true)
 {
   constexpr int CELL = 4;
   const auto synthetic = dynvo::test::makeSyntheticFlow(
@@ -313,7 +314,7 @@ setRegionFrame(dynvo::RigidMotionSegmentation<pcl::PointXYZRGB>& segmentation,
       {{box[0], box[1], box[2], box[3], 1.2,
         dynvo::test::makeMotion({0, 0, 1}, 0.0, {step, 0.0, 0.0}), 2}},
       5e-4, static_cast<std::uint32_t>(k + 1));
-  if (!box_measured)
+  if (!box_measured || !box_tracked)
     for (std::size_t i = 0; i < synthetic.truth.size(); ++i)
       if (synthetic.truth[i] == 2) {
         dynvo::PointFlow& cell = (*synthetic.flow)[i];
@@ -321,6 +322,10 @@ setRegionFrame(dynvo::RigidMotionSegmentation<pcl::PointXYZRGB>& segmentation,
         cell.prev_x = cell.prev_y = cell.prev_z = none;
         cell.valid_3d = 0;
         cell.weight = 0.0f;
+        if (!box_tracked) {
+          cell.prev_u = cell.prev_v = none;
+          cell.valid_2d = 0;
+        }
       }
   segmentation.setInputCloud(
       dynvo::test::cloudFromFlow<pcl::PointXYZRGB>(*synthetic.flow, CELL));
@@ -481,6 +486,31 @@ TEST(ObjectBirth, ObjectMeasuredEveryOtherFrameIsNeverOutput)
                            segmentation.getCellLabels().end(), std::uint8_t{2}),
                 56)
           << "frame " << k;
+  }
+}
+
+TEST(SegmentTracking, ObjectKeepsItsIdOverAFrameWithoutTracksOnItsCells)
+{
+  // The box moves 4 cm per frame from frame 3; on frame 6 none of its cells has a 2D track
+  // (a blurred frame, a depth hole). The past label maps are warped into each frame through
+  // every cell's source (docs/algorithm.md §4, §6): without a track, the reprojection of b_i
+  // through H_pred, here onto the cell itself. The box is matched on frame 7 against the
+  // map of frame 5 and keeps its id; warped through tracks only, the maps lost the box's
+  // cells on frame 6 and it came back as a new object.
+  dynvo::RigidMotionSegmentation<pcl::PointXYZRGB> segmentation;
+  segmentation.setCameraIntrinsics(dynvo::test::intrinsicsFor(160));
+  segmentation.setObjectBirthFrames(1);
+  segmentation.setObjectBirthRatio(0.0f);
+  for (std::size_t k = 0; k < 9; ++k) {
+    const bool moving = k >= 3, tracked = k != 6;
+    setRegionFrame(segmentation, {4, 8, 12, 22}, moving ? 0.04 : 0.0, k, tracked,
+                   tracked);
+    std::vector<pcl::PointIndices> segments;
+    segmentation.segment(segments);
+    const std::vector<std::uint8_t> expected = moving && tracked
+                                                   ? std::vector<std::uint8_t>{1, 2}
+                                                   : std::vector<std::uint8_t>{1};
+    EXPECT_EQ(segmentation.getSegmentLabels(), expected) << "frame " << k;
   }
 }
 

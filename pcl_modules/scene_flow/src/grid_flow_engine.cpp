@@ -362,9 +362,12 @@ GridFlowEngine::track(const Frame& reference,
     return q.x >= 1.0f && q.y >= 1.0f && q.x <= width - 2.0f && q.y <= height - 2.0f;
   };
 
-  // Cells to track, and where each starts in the reference frame: the projection of
-  // T_reference_current * b_i, or of the cell's ray rotated alone (a point at infinity) when
-  // it has no depth. Unselected cells and those whose start leaves the image are left out.
+  // Cells to track: the selected ones with a depth b_i (a cell without one gives no 3D flow;
+  // about a fifth of a TUM fr1 frame has no depth). Each starts in the reference frame at the
+  // projection of T_reference_current * b_i; a start outside the image leaves the cell out.
+  const auto trackable = [&](std::size_t i) {
+    return (selected.empty() || selected[i]) && !std::isnan(centre_depth[i]);
+  };
   std::vector<std::size_t> tracked_cells;
   std::vector<cv::Point2f> seeds;
   tracked_cells.reserve(n);
@@ -372,13 +375,10 @@ GridFlowEngine::track(const Frame& reference,
   const Eigen::Matrix3f R = T_reference_current.topLeftCorner<3, 3>();
   const Eigen::Vector3f t = T_reference_current.topRightCorner<3, 1>();
   for (std::size_t i = 0; i < n; ++i) {
-    if (!selected.empty() && !selected[i])
+    if (!trackable(i))
       continue;
-    const bool at_infinity = std::isnan(centre_depth[i]);
-    const Eigen::Vector3f b = intrinsics.backproject(
-        centres[i].x, centres[i].y, at_infinity ? 1.0f : centre_depth[i]);
     const Eigen::Vector3f q =
-        at_infinity ? Eigen::Vector3f(R * b) : Eigen::Vector3f(R * b + t);
+        R * intrinsics.backproject(centres[i].x, centres[i].y, centre_depth[i]) + t;
     if (!(q.z() > 0.0f))
       continue;
     const Eigen::Vector2f seed = intrinsics.project(q);
@@ -402,7 +402,7 @@ GridFlowEngine::track(const Frame& reference,
       tracked_cells.clear();
       seeds.clear();
       for (std::size_t i = 0; i < n; ++i)
-        if (selected.empty() || selected[i]) {
+        if (trackable(i)) {
           tracked_cells.push_back(i);
           seeds.push_back(centres[i]);
         }
@@ -469,9 +469,10 @@ GridFlowEngine::track(const Frame& reference,
 
   // Each cell's image velocity (px/s): frame to frame, that of this track; to the keyframe,
   // the one the current frame kept from its own frame-to-frame track (none: zero). A cell
-  // without a track (LK or its check failed) takes its nearest tracked cell's: the image
-  // motion is smooth, and zero put the depth instants of the keyframe points falling in such
-  // a cell off by the velocity times the depth-colour offset (docs/algorithm.md §1.2).
+  // without a track (no depth, or LK or its check failed) takes its nearest tracked cell's:
+  // the image motion is smooth, and zero put the depth instants of the keyframe points
+  // falling in such a cell off by the velocity times the depth-colour offset
+  // (docs/algorithm.md §1.2).
   velocity.assign(n, Eigen::Vector2f::Zero());
   if (frame_to_frame) {
     const double dt = curr.stamps.colour - prev.stamps.colour;

@@ -95,7 +95,8 @@ private:
                     const Eigen::Matrix4d& T_pred,
                     const CameraIntrinsics& intrinsics);
 
-  /// Nearest-cell warp of a previous-grid map into the current grid (valid_2d only).
+  /// Nearest-cell warp of a previous-grid map into the current grid through each cell's
+  /// source pixel (sourcePixels(), computed first in update()).
   std::vector<std::uint8_t> warpNearest(const std::vector<std::uint8_t>& map,
                                         const GridFlowData& grid) const;
 

@@ -74,10 +74,10 @@ public:
    * Both slots must have been prepared with the same size and params. When the prediction
    * moves the cells farther than the pyramid reaches ((window_size / 2) * 2^max_pyramid_level
    * px, median over the cells), every cell starts at its predicted position in the previous
-   * frame, the projection of T_previous_current * b_i (a cell without depth: of its ray, as a
-   * point at infinity); otherwise every cell starts where it is. The whole pyramid is
-   * searched. The current slot keeps each cell's image velocity (px/s) for the depth
-   * instants of later fits (docs/algorithm.md §1.2).
+   * frame, the projection of T_previous_current * b_i; otherwise every cell starts where it
+   * is. Cells without depth at c_i are not tracked. The whole pyramid is searched. The
+   * current slot keeps each cell's image velocity (px/s) for the depth instants of later
+   * fits; a cell without a track takes its nearest tracked cell's (docs/algorithm.md §1.2).
    * \param[out] flow organized (width / cell_size) x (height / cell_size) cloud
    */
   void compute(const GridSceneFlowParameters& params,

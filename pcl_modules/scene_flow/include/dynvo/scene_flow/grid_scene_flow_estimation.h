@@ -31,7 +31,8 @@ namespace dynvo {
  * Output: organized (width / cell_size) x (height / cell_size) cloud; cell i = row * cols + col,
  * the geometry of FlowGrid, from which the consumers infer the cell size (a cell size for which
  * width / (width / cell_size) != cell_size is an input error, see FlowGrid::isInferable()).
- * u, v always hold c_i. valid_2d cells hold p_i in prev_u, prev_v (NaN otherwise); x, y, z hold b_i
+ * u, v always hold c_i. Only cells with depth at c_i are tracked (the others give no 3D flow).
+ * valid_2d cells hold p_i in prev_u, prev_v (NaN otherwise); x, y, z hold b_i
  * whenever depth exists at c_i; valid_3d cells also hold a_i and a weight in (0, 1]. Every other
  * field is NaN and the weight 0. setIndices() is not used: every cell is computed.
  *
@@ -118,7 +119,7 @@ public:
 
   /** \brief Predicted camera motion H_pred = T_curr_prev of the next compute() (metres;
    * default identity): each cell starts its search at its predicted position in the previous
-   * frame (a cell without depth as a point at infinity) and the whole pyramid is searched
+   * frame and the whole pyramid is searched
    * around it, so a fast but steady motion stays within the pyramid's reach
    * (docs/algorithm.md §1.2).
    */
