@@ -400,6 +400,33 @@ TEST(CellAndPixelStages, PixelStageOnAnotherThreadGivesTheOutputOfSegment)
   EXPECT_TRUE(empty.getPixelLabels().empty());
 }
 
+/// A segmentation of setRegionFrame()'s frames: an object is output from its
+/// `birth_frames`-th consecutive frame, with the ratio exemption `birth_ratio` (0: none).
+void
+setUpBirth(dynvo::RigidMotionSegmentation<pcl::PointXYZRGB>& segmentation,
+           int birth_frames,
+           float birth_ratio = 0.0f)
+{
+  segmentation.setCameraIntrinsics(dynvo::test::intrinsicsFor(160));
+  segmentation.setObjectBirthFrames(birth_frames);
+  segmentation.setObjectBirthRatio(birth_ratio);
+}
+
+/// setRegionFrame(), then segment(): the ids output for the frame.
+std::vector<std::uint8_t>
+segmentRegionFrame(dynvo::RigidMotionSegmentation<pcl::PointXYZRGB>& segmentation,
+                   const std::array<int, 4>& box,
+                   double step,
+                   std::size_t k,
+                   bool box_measured = true,
+                   bool box_tracked = true)
+{
+  setRegionFrame(segmentation, box, step, k, box_measured, box_tracked);
+  std::vector<pcl::PointIndices> segments;
+  segmentation.segment(segments);
+  return segmentation.getSegmentLabels();
+}
+
 /// Output ids per frame while the box of segmentBoxFrame() (from column 4) moves 4 cm per
 /// frame along x in the frames where `moving` is set and stands still (part of the
 /// background) in the others; also checks that its cells stay out of the fit's static set
@@ -408,9 +435,7 @@ std::vector<std::vector<std::uint8_t>>
 newObjectOutputs(const std::vector<bool>& moving, int birth_frames, float birth_ratio)
 {
   dynvo::RigidMotionSegmentation<pcl::PointXYZRGB> segmentation;
-  segmentation.setCameraIntrinsics(dynvo::test::intrinsicsFor(160));
-  segmentation.setObjectBirthFrames(birth_frames);
-  segmentation.setObjectBirthRatio(birth_ratio);
+  setUpBirth(segmentation, birth_frames, birth_ratio);
   std::vector<std::vector<std::uint8_t>> outputs;
   for (std::size_t k = 0; k < moving.size(); ++k) {
     const auto [segments, truth] =
@@ -469,15 +494,12 @@ TEST(ObjectBirth, ObjectMeasuredEveryOtherFrameIsNeverOutput)
   // measured frame output it on frame 7). The box's cells: no 3D flow on frames 0-2 (their
   // models stay empty) and on the even frames, 4 cm of motion on frames 3, 5, 7, 9.
   dynvo::RigidMotionSegmentation<pcl::PointXYZRGB> segmentation;
-  segmentation.setCameraIntrinsics(dynvo::test::intrinsicsFor(160));
-  segmentation.setObjectBirthFrames(3);
-  segmentation.setObjectBirthRatio(0.0f);
+  setUpBirth(segmentation, 3);
   for (std::size_t k = 0; k < 11; ++k) {
     const bool measured = k >= 3 && k % 2 == 1;
-    setRegionFrame(segmentation, {4, 8, 12, 22}, measured ? 0.04 : 0.0, k, measured);
-    std::vector<pcl::PointIndices> segments;
-    segmentation.segment(segments);
-    EXPECT_EQ(segmentation.getSegmentLabels(), (std::vector<std::uint8_t>{1}))
+    EXPECT_EQ(segmentRegionFrame(segmentation, {4, 8, 12, 22}, measured ? 0.04 : 0.0, k,
+                                 measured),
+              (std::vector<std::uint8_t>{1}))
         << "frame " << k;
     // Not vacuous: the tracker holds the object's id throughout, on at least half of the
     // box's 112 cells (on the frames without 3D flow the model keeps 70-98 of them).
@@ -498,19 +520,16 @@ TEST(SegmentTracking, ObjectKeepsItsIdOverAFrameWithoutTracksOnItsCells)
   // map of frame 5 and keeps its id; warped through tracks only, the maps lost the box's
   // cells on frame 6 and it came back as a new object.
   dynvo::RigidMotionSegmentation<pcl::PointXYZRGB> segmentation;
-  segmentation.setCameraIntrinsics(dynvo::test::intrinsicsFor(160));
-  segmentation.setObjectBirthFrames(1);
-  segmentation.setObjectBirthRatio(0.0f);
+  setUpBirth(segmentation, 1);
   for (std::size_t k = 0; k < 9; ++k) {
     const bool moving = k >= 3, tracked = k != 6;
-    setRegionFrame(segmentation, {4, 8, 12, 22}, moving ? 0.04 : 0.0, k, tracked,
-                   tracked);
-    std::vector<pcl::PointIndices> segments;
-    segmentation.segment(segments);
     const std::vector<std::uint8_t> expected = moving && tracked
                                                    ? std::vector<std::uint8_t>{1, 2}
                                                    : std::vector<std::uint8_t>{1};
-    EXPECT_EQ(segmentation.getSegmentLabels(), expected) << "frame " << k;
+    EXPECT_EQ(segmentRegionFrame(segmentation, {4, 8, 12, 22}, moving ? 0.04 : 0.0, k,
+                                 tracked, tracked),
+              expected)
+        << "frame " << k;
   }
 }
 
@@ -524,15 +543,11 @@ TEST(ObjectBirth, ShortLivedObjectsDoNotUseUpTheLabels)
   // of its id (two measurements against a static apparent model of age 5 never swap), and
   // that evidence alone must not reserve the id.
   dynvo::RigidMotionSegmentation<pcl::PointXYZRGB> segmentation;
-  segmentation.setCameraIntrinsics(dynvo::test::intrinsicsFor(160));
-  segmentation.setObjectBirthFrames(1);
-  segmentation.setObjectBirthRatio(0.0f);
+  setUpBirth(segmentation, 1);
   std::size_t k = 0;
   const auto frame = [&](int col0, int row0, double step) {
-    setRegionFrame(segmentation, {col0, row0, col0 + 5, row0 + 5}, step, k++);
-    std::vector<pcl::PointIndices> segments;
-    segmentation.segment(segments);
-    return segmentation.getSegmentLabels();
+    return segmentRegionFrame(segmentation, {col0, row0, col0 + 5, row0 + 5}, step,
+                              k++);
   };
   for (int still = 0; still < 3; ++still) // the background first
     frame(2, 2, 0.0);
