@@ -2,8 +2,10 @@
 #include <dynvo/common/parallel.h>
 
 #include <gtest/gtest.h>
+#include <opencv2/core/utility.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cstddef>
 #include <mutex>
 #include <thread>
@@ -51,6 +53,34 @@ TEST(ForEachStripe, OneThreadRunsOnTheCallersThread)
   });
   EXPECT_EQ(seen, std::this_thread::get_id());
   EXPECT_EQ(stripesOf(1000, 1).second, 1u);
+}
+
+TEST(ForEachStripe, OneThreadKeepsOpenCVsOwnLoopsOnIt)
+{
+  // OpenCV's functions (LK, pyramids) run their own parallel_for_ on its whole pool unless
+  // they are nested in a running one: a single stripe must still be such a region, or
+  // `-threads 1` uses every core (a bug seen in the benchmark, not in any result).
+  if (cv::getNumThreads() < 2)
+    GTEST_SKIP() << "OpenCV's pool has one thread here: nothing to keep off it";
+  std::mutex mutex;
+  std::vector<std::thread::id> seen;
+  dynvo::forEachStripe(1, 1, [&](std::size_t, std::size_t) {
+    cv::parallel_for_(
+        cv::Range(0, 64),
+        [&](const cv::Range& range) {
+          for (int i = range.start; i < range.end; ++i) {
+            // Long enough for OpenCV's idle workers to wake up and take items, had they
+            // been allowed to.
+            std::this_thread::sleep_for(std::chrono::milliseconds(1));
+            const std::lock_guard<std::mutex> lock(mutex);
+            seen.push_back(std::this_thread::get_id());
+          }
+        },
+        64.0);
+  });
+  ASSERT_EQ(seen.size(), 64u);
+  for (const std::thread::id& id : seen)
+    EXPECT_EQ(id, std::this_thread::get_id());
 }
 
 } // namespace

@@ -15,10 +15,8 @@ forEachStripe(std::size_t n,
   const std::size_t stripes = std::min<std::size_t>(threads, n);
   if (stripes == 0)
     return;
-  if (stripes == 1) {
-    body(0, n);
-    return;
-  }
+  // One stripe goes through parallel_for_ too: OpenCV runs it on the caller's thread, and
+  // the OpenCV calls body makes inside it serially (not on OpenCV's whole pool).
   cv::parallel_for_(
       cv::Range(0, static_cast<int>(stripes)),
       [&](const cv::Range& range) {

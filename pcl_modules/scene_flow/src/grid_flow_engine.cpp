@@ -3,7 +3,6 @@
 
 #include <dynvo/common/parallel.h>
 
-#include "parallel_stripes.h"
 
 #include <opencv2/core.hpp>
 #include <opencv2/video/tracking.hpp>
@@ -265,7 +264,7 @@ GridFlowEngine::prepare(Slot slot,
   // preprocessing about 0.8 ms, the pyramid 0.3 ms, the centres' depths 0.2 ms.)
   frame.preprocessing.apply(depth, width, height, frame.depth);
   const unsigned tasks = std::min(threads, 2u);
-  runStripes(tasks, [&](unsigned s) {
+  forEachStripe(tasks, tasks, [&](std::size_t s, std::size_t) {
     if (s == 0)
       build_pyramid();
     if (s + 1 == tasks)
@@ -422,8 +421,8 @@ GridFlowEngine::track(const Frame& reference,
   // Stripe s takes every stripes-th cell from the s-th: the stripes cover the whole image
   // alike, so their cost is even (contiguous stripes are not: the top and bottom of an image
   // differ in texture). Each point is tracked on its own: the same flow for any split.
-  const unsigned stripes = static_cast<unsigned>(std::min<std::size_t>(threads, m));
-  runStripes(stripes, [&](unsigned s) {
+  const std::size_t stripes = std::min<std::size_t>(threads, m);
+  forEachStripe(stripes, threads, [&](std::size_t s, std::size_t) {
     std::vector<std::size_t> cells;
     std::vector<cv::Point2f> from, to;
     for (std::size_t k = s; k < m; k += stripes) {
