@@ -3,7 +3,6 @@
 
 #include <dynvo/common/parallel.h>
 
-
 #include <opencv2/core.hpp>
 #include <opencv2/video/tracking.hpp>
 
