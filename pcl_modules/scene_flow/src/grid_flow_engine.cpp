@@ -421,7 +421,7 @@ GridFlowEngine::track(const Frame& reference,
   // alike, so their cost is even (contiguous stripes are not: the top and bottom of an image
   // differ in texture). Each point is tracked on its own: the same flow for any split.
   const std::size_t stripes = std::min<std::size_t>(threads, m);
-  forEachStripe(stripes, threads, [&](std::size_t s, std::size_t) {
+  forEachStripe(stripes, stripes, [&](std::size_t s, std::size_t) {
     std::vector<std::size_t> cells;
     std::vector<cv::Point2f> from, to;
     for (std::size_t k = s; k < m; k += stripes) {
