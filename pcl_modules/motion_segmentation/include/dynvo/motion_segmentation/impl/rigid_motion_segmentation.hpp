@@ -371,7 +371,9 @@ RigidMotionSegmentation<PointT>::updateNoiseScale()
   const Eigen::Matrix3f R = motions_[0].topLeftCorner<3, 3>();
   const Eigen::Vector3f t = motions_[0].topRightCorner<3, 1>();
   std::array<std::vector<float>, 2> ratios;
-  for (std::size_t i = 0; i < grid_.size(); ++i)
+  std::size_t measured = 0;
+  for (std::size_t i = 0; i < grid_.size(); ++i) {
+    measured += grid_.valid_3d[i] ? 1 : 0;
     if (grid_.valid_3d[i] && grid_.error(i, R, t) <= 4.0f * params_.inlier_chi2) {
       const Eigen::Vector3f& a = grid_.a[i];
       const Eigen::Vector3f& b = grid_.b[i];
@@ -382,14 +384,24 @@ RigidMotionSegmentation<PointT>::updateNoiseScale()
       ratios[0].push_back(axial * axial / variance.axial);
       ratios[1].push_back((e.squaredNorm() - axial * axial) / variance.lateral);
     }
-  if (ratios[0].size() < MIN_CELLS)
+  }
+  if (measured < MIN_CELLS)
     return;
+  // Fewer than MIN_CELLS of the valid cells within reach: the frame lies beyond the gains (a
+  // blurred frame after a repeated or a sharp one; without a background the motion is the
+  // prediction the tracker keeps, and the frame's own motion lies beyond them too). Fitted on
+  // the few cells within reach, the gains would stay as small and no sample would fit on the
+  // next frames either: they move half way to s_max instead (docs/algorithm.md §3.0).
+  const bool beyond_reach = ratios[0].size() < MIN_CELLS;
   for (int k = 0; k < 2; ++k) {
-    std::vector<float>& r = ratios[k];
-    const auto middle = r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2);
-    std::nth_element(r.begin(), middle, r.end());
+    float fitted = params_.noise_scale_max;
+    if (!beyond_reach) {
+      std::vector<float>& r = ratios[k];
+      const auto middle = r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2);
+      std::nth_element(r.begin(), middle, r.end());
+      fitted = std::sqrt(*middle / MEDIAN[k]);
+    }
     // Geometric mean with the previous gain: the fit of one frame moves it half way.
-    const float fitted = std::sqrt(*middle / MEDIAN[k]);
     noise_gains_[k] = std::clamp(std::sqrt(noise_gains_[k] * fitted),
                                  params_.noise_scale_min, params_.noise_scale_max);
   }
