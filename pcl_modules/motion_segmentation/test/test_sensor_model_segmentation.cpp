@@ -161,7 +161,7 @@ TEST(SensorModelSegmentation, GainsRecoverAfterARepeatedFrame)
   // their floor s_min = 0.2 at once, and the constant-velocity prediction of the next frame
   // is no motion. The next frames are blurred (2 px of tracking noise, about what a 68 ms gap
   // of a hand-held sweep leaves) while the camera moves on (1 cm and 0.6 deg per frame): at
-  // 2 m the blur alone is 12 floor sigmas across the ray and the motion tens of them, so no
+  // 2 m the blur alone is 17 floor sigmas across the ray and the motion tens of them, so no
   // 7-cell sample fits within th_chi2 and no cell lies within reach of the gains' fit
   // (4 th_chi2, about 8 sigma). Fitted only on the cells within reach, the gains stayed at
   // the floor and no cell was static again; beyond reach they move half way to s_max on
