@@ -6,6 +6,8 @@
 #include <opencv2/core.hpp>
 #include <opencv2/video/tracking.hpp>
 
+#include "lucas_kanade.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -412,9 +414,12 @@ GridFlowEngine::track(const Frame& reference,
   const std::size_t m = tracked_cells.size();
   std::vector<cv::Point2f> tracked(n, cv::Point2f(NaN, NaN));
   std::vector<std::uint8_t> valid2d(n, 0);
-  const cv::Size window(params.window_size, params.window_size);
-  const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
-                                  params.max_iterations, params.epsilon);
+  LucasKanadeSettings lk;
+  lk.window = params.window_size;
+  lk.max_level = max_level;
+  lk.max_iterations = params.max_iterations;
+  lk.epsilon = params.epsilon;
+  lk.min_eigen_threshold = params.min_eigen_threshold;
   const float fb2 =
       params.forward_backward_threshold * params.forward_backward_threshold;
   // Stripe s takes every stripes-th cell from the s-th: the stripes cover the whole image
@@ -430,9 +435,7 @@ GridFlowEngine::track(const Frame& reference,
       to.push_back(seeds[k]);
     }
     std::vector<std::uint8_t> status;
-    cv::calcOpticalFlowPyrLK(curr.pyramid, prev.pyramid, from, to, status,
-                             cv::noArray(), window, max_level, criteria,
-                             cv::OPTFLOW_USE_INITIAL_FLOW, params.min_eigen_threshold);
+    trackLucasKanade(curr.pyramid, prev.pyramid, from, lk, to, status);
     std::vector<cv::Point2f> forward;
     std::vector<std::size_t> index;
     for (std::size_t k = 0; k < from.size(); ++k) {
@@ -446,19 +449,18 @@ GridFlowEngine::track(const Frame& reference,
     }
     if (forward.empty())
       return;
+    // Full: from scratch through the pyramid (the search starts at p_i itself); local:
+    // from c_i on the finest level.
     std::vector<cv::Point2f> back;
-    if (params.forward_backward_check == ForwardBackwardCheck::full) {
-      cv::calcOpticalFlowPyrLK(prev.pyramid, curr.pyramid, forward, back, status,
-                               cv::noArray(), window, max_level, criteria, 0,
-                               params.min_eigen_threshold);
-    }
+    LucasKanadeSettings check = lk;
+    if (params.forward_backward_check == ForwardBackwardCheck::full)
+      back = forward;
     else {
+      check.max_level = 0;
       for (const std::size_t i : index)
         back.push_back(centres[i]);
-      cv::calcOpticalFlowPyrLK(
-          prev.pyramid, curr.pyramid, forward, back, status, cv::noArray(), window, 0,
-          criteria, cv::OPTFLOW_USE_INITIAL_FLOW, params.min_eigen_threshold);
     }
+    trackLucasKanade(prev.pyramid, curr.pyramid, forward, check, back, status);
     for (std::size_t k = 0; k < forward.size(); ++k) {
       const cv::Point2f d = back[k] - centres[index[k]];
       valid2d[index[k]] = status[k] && d.dot(d) <= fb2;
