@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "lucas_kanade.h"
 
+#include "lucas_kanade_kernels.h"
+
 #include <opencv2/core/hal/intrin.hpp>
 
 #include <algorithm>
@@ -9,11 +11,14 @@
 
 namespace dynvo::detail {
 
-namespace {
+using lk::FLT_SCALE;
+using lk::Mismatch;
+using lk::Normal;
+using lk::Rows;
+using lk::W_BITS;
+using lk::Weights;
 
-// Fixed point of OpenCV's LK: bilinear weights in 14 bits, grey levels kept x 32.
-constexpr int W_BITS = 14;
-constexpr float FLT_SCALE = 1.0f / (1 << 20);
+namespace {
 
 /// x / 2^n rounded half up, in integers.
 constexpr int
@@ -23,10 +28,6 @@ descale(int x, int n)
 }
 
 /// Bilinear weights of the fractional offsets (a, b), rounded as OpenCV rounds them.
-struct Weights {
-  int w00, w01, w10, w11;
-};
-
 Weights
 weightsOf(float a, float b)
 {
@@ -38,26 +39,18 @@ weightsOf(float a, float b)
   return w;
 }
 
-} // namespace
-
-namespace {
-
-/** The window of `I` at top-left corner (x0 + a, y0 + b): grey levels x 32 into `grey`,
- * interleaved gradients into `gradient`, and the gradients' normal matrix. */
-void
-makeTemplate(const cv::Mat& I,
-             const cv::Mat& dI,
-             cv::Point2i corner,
-             const Weights& w,
-             int window,
-             short* grey,
-             short* gradient,
-             float& A11,
-             float& A12,
-             float& A22)
+/** The template of a window (128-bit integer arithmetic, OpenCV's code path): grey levels
+ * x 32 into `grey`, interleaved gradients into `window_gradient`, and their normal matrix. */
+Normal
+makeTemplate128(Rows<std::uint8_t> image,
+                Rows<short> gradient,
+                const Weights& w,
+                int window,
+                short* grey,
+                short* window_gradient)
 {
-  const int step_i = static_cast<int>(I.step / I.elemSize1());
-  const int step_d = static_cast<int>(dI.step / dI.elemSize1());
+  const std::ptrdiff_t step_i = image.step;
+  const std::ptrdiff_t step_d = gradient.step;
   float iA11 = 0, iA12 = 0, iA22 = 0;
 #if CV_SIMD128
   const cv::v_int16x8 qw0(static_cast<short>(w.w00), static_cast<short>(w.w01),
@@ -74,13 +67,10 @@ makeTemplate(const cv::Mat& I,
                   qA22 = cv::v_setzero_f32();
 #endif
   for (int y = 0; y < window; ++y) {
-    const std::uint8_t* src =
-        I.data + static_cast<std::ptrdiff_t>(y + corner.y) * step_i + corner.x;
-    const short* dsrc = reinterpret_cast<const short*>(dI.data) +
-                        static_cast<std::ptrdiff_t>(y + corner.y) * step_d +
-                        corner.x * 2;
+    const std::uint8_t* src = image.origin + y * step_i;
+    const short* dsrc = gradient.origin + y * step_d;
     short* Iptr = grey + y * window;
-    short* dIptr = gradient + y * window * 2;
+    short* dIptr = window_gradient + y * window * 2;
     int x = 0;
 #if CV_SIMD128
     for (; x <= window - 8; x += 8, dsrc += 16, dIptr += 16) {
@@ -147,23 +137,18 @@ makeTemplate(const cv::Mat& I,
   iA12 += cv::v_reduce_sum(qA12);
   iA22 += cv::v_reduce_sum(qA22);
 #endif
-  A11 = iA11 * FLT_SCALE;
-  A12 = iA12 * FLT_SCALE;
-  A22 = iA22 * FLT_SCALE;
+  return {iA11 * FLT_SCALE, iA12 * FLT_SCALE, iA22 * FLT_SCALE};
 }
 
-/// sum over the window of (J(x + corner + w) - I) * gradient, as OpenCV sums it.
-void
-mismatch(const cv::Mat& J,
-         cv::Point2i corner,
-         const Weights& w,
-         int window,
-         const short* grey,
-         const short* gradient,
-         float& b1,
-         float& b2)
+/// The mismatch of a template (makeTemplate128's) at a window of `image`, as OpenCV sums it.
+Mismatch
+mismatch128(Rows<std::uint8_t> image,
+            const Weights& w,
+            int window,
+            const short* grey,
+            const short* window_gradient)
 {
-  const int step_j = static_cast<int>(J.step / J.elemSize1());
+  const std::ptrdiff_t step_j = image.step;
   float ib1 = 0, ib2 = 0;
 #if CV_SIMD128
   const cv::v_int16x8 qw0(static_cast<short>(w.w00), static_cast<short>(w.w01),
@@ -178,10 +163,9 @@ mismatch(const cv::Mat& J,
   cv::v_float32x4 qb0 = cv::v_setzero_f32(), qb1 = cv::v_setzero_f32();
 #endif
   for (int y = 0; y < window; ++y) {
-    const std::uint8_t* Jptr =
-        J.data + static_cast<std::ptrdiff_t>(y + corner.y) * step_j + corner.x;
+    const std::uint8_t* Jptr = image.origin + y * step_j;
     const short* Iptr = grey + y * window;
-    const short* dIptr = gradient + y * window * 2;
+    const short* dIptr = window_gradient + y * window * 2;
     int x = 0;
 #if CV_SIMD128
     for (; x <= window - 8; x += 8, dIptr += 16) {
@@ -225,8 +209,31 @@ mismatch(const cv::Mat& J,
   ib1 += cv::v_reduce_sum(qf0);
   ib2 += cv::v_reduce_sum(qf1);
 #endif
-  b1 = ib1 * FLT_SCALE;
-  b2 = ib2 * FLT_SCALE;
+  return {ib1 * FLT_SCALE, ib2 * FLT_SCALE};
+}
+
+/// The rows of a pyramid level's image or gradients from the window corner (x, y).
+template <typename T>
+Rows<T>
+rowsAt(const cv::Mat& m, cv::Point2i corner, int channels)
+{
+  const std::ptrdiff_t step = static_cast<std::ptrdiff_t>(m.step / m.elemSize1());
+  return {reinterpret_cast<const T*>(m.data) + corner.y * step + corner.x * channels,
+          step};
+}
+
+/// Whether the 256-bit kernels run: built for x86-64, the CPU has AVX2, and the window's
+/// rows are whole multiples of 16 pixels.
+bool
+wideKernels(const LucasKanadeSettings& s)
+{
+#if defined(DYNVO_LK_AVX2)
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  return s.wide && avx2 && s.window % 16 == 0;
+#else
+  (void)s;
+  return false;
+#endif
 }
 
 } // namespace
@@ -253,6 +260,7 @@ trackLucasKanade(const std::vector<cv::Mat>& from_pyramid,
   const cv::Point2f half_window((window - 1) * 0.5f, (window - 1) * 0.5f);
   std::vector<short> grey(static_cast<std::size_t>(window) * window);
   std::vector<short> gradient(grey.size() * 2);
+  const bool wide = wideKernels(s);
 
   status.assign(from.size(), 1);
   for (std::size_t i = 0; i < from.size(); ++i) {
@@ -273,9 +281,14 @@ trackLucasKanade(const std::vector<cv::Mat>& from_pyramid,
           status[i] = 0;
         continue;
       }
-      float A11, A12, A22;
-      makeTemplate(I, dI, iprev, weightsOf(prev.x - iprev.x, prev.y - iprev.y), window,
-                   grey.data(), gradient.data(), A11, A12, A22);
+      const Rows<std::uint8_t> image = rowsAt<std::uint8_t>(I, iprev, 1);
+      const Rows<short> image_gradient = rowsAt<short>(dI, iprev, 2);
+      const Weights w = weightsOf(prev.x - iprev.x, prev.y - iprev.y);
+      const auto [A11, A12, A22] =
+          wide ? lk::makeTemplate256(image, image_gradient, w, window, grey.data(),
+                                     gradient.data())
+               : makeTemplate128(image, image_gradient, w, window, grey.data(),
+                                 gradient.data());
       float D = A11 * A22 - A12 * A12;
       const float min_eigen =
           (A22 + A11 - std::sqrt((A11 - A22) * (A11 - A22) + 4.f * A12 * A12)) /
@@ -296,9 +309,11 @@ trackLucasKanade(const std::vector<cv::Mat>& from_pyramid,
             status[i] = 0;
           break;
         }
-        float b1, b2;
-        mismatch(J, inext, weightsOf(next.x - inext.x, next.y - inext.y), window,
-                 grey.data(), gradient.data(), b1, b2);
+        const Rows<std::uint8_t> target = rowsAt<std::uint8_t>(J, inext, 1);
+        const Weights wn = weightsOf(next.x - inext.x, next.y - inext.y);
+        const auto [b1, b2] =
+            wide ? lk::mismatch256(target, wn, window, grey.data(), gradient.data())
+                 : mismatch128(target, wn, window, grey.data(), gradient.data());
         const cv::Point2f delta(static_cast<float>((A12 * b2 - A22 * b1) * D),
                                 static_cast<float>((A12 * b1 - A11 * b2) * D));
         next += delta;

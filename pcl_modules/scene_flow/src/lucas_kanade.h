@@ -16,6 +16,9 @@ struct LucasKanadeSettings {
   int max_iterations = 8;            ///< iteration cap per level
   double epsilon = 0.03;             ///< an update shorter than this (px) ends a level
   double min_eigen_threshold = 1e-4; ///< a smaller window eigenvalue fails the track
+  /// 256-bit kernels where the CPU has AVX2 and the window is a multiple of 16 px (the
+  /// same results; false: the 128-bit kernels, which OpenCV runs)
+  bool wide = true;
 };
 
 /** \brief Sparse pyramidal Lucas-Kanade with the arithmetic of OpenCV 4.6's

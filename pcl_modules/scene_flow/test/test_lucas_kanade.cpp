@@ -105,18 +105,24 @@ expectSameAsOpenCV(const std::vector<cv::Mat>& from_pyramid,
       cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
                        s.max_iterations, s.epsilon),
       cv::OPTFLOW_USE_INITIAL_FLOW, s.min_eigen_threshold);
-  tracked = guess;
-  trackLucasKanade(from_pyramid, to_pyramid, from, s, tracked, status);
-  ASSERT_EQ(status.size(), from.size());
-  std::size_t differ = 0, failed = 0;
-  for (std::size_t i = 0; i < from.size(); ++i) {
-    failed += status[i] ? 0 : 1;
-    // A failed track's point is whatever the search left: OpenCV's too, so it is compared.
-    if (status[i] != reference_status[i] || tracked[i].x != reference[i].x ||
-        tracked[i].y != reference[i].y)
-      ++differ;
+  // Both kernel widths (the 256-bit ones run only where the CPU has AVX2).
+  for (const bool wide : {false, true}) {
+    LucasKanadeSettings settings = s;
+    settings.wide = wide;
+    tracked = guess;
+    trackLucasKanade(from_pyramid, to_pyramid, from, settings, tracked, status);
+    ASSERT_EQ(status.size(), from.size());
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < from.size(); ++i)
+      // A failed track's point is whatever the search left: OpenCV's too, so it is
+      // compared.
+      if (status[i] != reference_status[i] || tracked[i].x != reference[i].x ||
+          tracked[i].y != reference[i].y)
+        ++differ;
+    EXPECT_EQ(differ, 0u) << "of " << from.size() << " tracks, wide " << wide;
   }
-  EXPECT_EQ(differ, 0u) << "of " << from.size() << " tracks";
+  const auto failed =
+      static_cast<std::size_t>(std::count(status.begin(), status.end(), 0));
   // Both outcomes are compared: some tracks fail (the points beyond the borders; the
   // noiseless flat band's cells, when it is the image tracked from), most succeed.
   EXPECT_GE(failed, least_failed);
@@ -183,6 +189,19 @@ TEST(LucasKanade, SameAsOpenCVWithAnOddWindowAndOtherRules)
   std::vector<cv::Point2f> tracked;
   std::vector<std::uint8_t> status;
   expectSameAsOpenCV(pair.first, pair.second, from, from, s, 40, tracked, status);
+}
+
+TEST(LucasKanade, SameAsOpenCVWithAWindowOfTwoWideRows)
+{
+  // Window 32: each row is two 16 px steps of the 256-bit kernels (four of the 128-bit).
+  const Pair pair = pyramids(32, 1);
+  const std::vector<cv::Point2f> from = points();
+  LucasKanadeSettings s;
+  s.window = 32;
+  s.max_level = 1;
+  std::vector<cv::Point2f> tracked;
+  std::vector<std::uint8_t> status;
+  expectSameAsOpenCV(pair.first, pair.second, from, from, s, 6, tracked, status);
 }
 
 TEST(LucasKanade, RejectsMismatchedInput)
