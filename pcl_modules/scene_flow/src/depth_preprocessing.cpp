@@ -2,6 +2,7 @@
 #include <dynvo/scene_flow/depth_preprocessing.h>
 
 #include <dynvo/common/parallel.h>
+#include <dynvo/common/vectorize.h>
 
 #include <algorithm>
 #include <cmath>
@@ -32,6 +33,64 @@ bool
 similar(float zl, float zr, float tolerance)
 {
   return std::abs(zl - zr) <= tolerance * std::min(zl, zr);
+}
+
+/// The depth kept at a pixel of in-range depth z (NaN: none) given its in-range neighbours
+/// n[0..count): NaN when it flies off their median m, i.e. when m < z lo_factor or
+/// m > z hi_factor (see apply()). Branch-free, so that rows vectorise.
+inline float
+keepPixel(float z, const float* n, int count, float lo_factor, float hi_factor)
+{
+  const float lo = z * lo_factor;
+  const float hi = z * hi_factor;
+  int valid = 0, below = 0, above = 0;
+  for (int j = 0; j < count; ++j) {
+    valid += n[j] == n[j];
+    below += n[j] < lo;
+    above += n[j] > hi;
+  }
+  const int k = valid / 2; // index of the median in the sorted valid neighbours
+  const bool flying =
+      (valid >= MIN_FLYING_NEIGHBOURS) & ((below >= k + 1) | (above >= valid - k));
+  return flying ? NaN : z; // NaN stays NaN
+}
+
+/** For the pixels of row y of a column stripe: where a valid pixel closes a gap of 1 to
+ * max_gap rows below its column's last valid row, gap_from = that row (else -1); then
+ * last = y where the pixel is valid. Returns how many close a gap (branch-free).
+ */
+DYNVO_VECTORIZE_FOR_AVX2 int
+markClosingGaps(
+    const float* row, std::size_t cols, int y, int max_gap, int* last, int* gap_from)
+{
+  int closing = 0;
+  for (std::size_t x = 0; x < cols; ++x) {
+    const bool valid = row[x] == row[x];
+    const int l = last[x];
+    const int gap = y - l - 1;
+    const bool closes = valid & (gap >= 1) & (gap <= max_gap);
+    gap_from[x] = closes ? l : -1;
+    closing += closes;
+    last[x] = valid ? y : l;
+  }
+  return closing;
+}
+
+/// keepPixel() on the pixels 1..w-2 of a row, from the in-range rows above, at and below it.
+DYNVO_VECTORIZE_FOR_AVX2 void
+keepInteriorRow(const float* up,
+                const float* mid,
+                const float* down,
+                float* dst,
+                std::size_t w,
+                float lo_factor,
+                float hi_factor)
+{
+  for (std::size_t x = 1; x + 1 < w; ++x) {
+    const float n[8] = {up[x - 1],  up[x],       up[x + 1], mid[x - 1],
+                        mid[x + 1], down[x - 1], down[x],   down[x + 1]};
+    dst[x] = keepPixel(mid[x], n, 8, lo_factor, hi_factor);
+  }
 }
 
 } // namespace
@@ -114,25 +173,8 @@ DepthPreprocessing::apply(const std::vector<float>& depth,
   const auto in_range = [z_min, z_max](float q) {
     return q >= z_min && q <= z_max ? q : NaN;
   };
-  // Depth kept at a pixel of in-range depth z given its in-range neighbours n[0..count)
-  // (branch-free for vectorising). Reciprocals, so that the per-pixel bounds cost
-  // multiplications rather than divisions.
   const float lo_factor = 1.0f / (1.0f + params_.flying_pixel_tolerance);
   const float hi_factor = 1.0f / (1.0f - params_.flying_pixel_tolerance);
-  const auto keep = [lo_factor, hi_factor](float z, const float* n, int count) {
-    const float lo = z * lo_factor;
-    const float hi = z * hi_factor;
-    int valid = 0, below = 0, above = 0;
-    for (int j = 0; j < count; ++j) {
-      valid += n[j] == n[j];
-      below += n[j] < lo;
-      above += n[j] > hi;
-    }
-    const int k = valid / 2; // index of the median in the sorted valid neighbours
-    const bool flying =
-        (valid >= MIN_FLYING_NEIGHBOURS) & ((below >= k + 1) | (above >= valid - k));
-    return flying ? NaN : z; // NaN stays NaN
-  };
   // Border pixels: gather the neighbours that exist.
   const auto border_pixel = [&](std::size_t x, std::size_t y) {
     float n[8];
@@ -141,7 +183,8 @@ DepthPreprocessing::apply(const std::vector<float>& depth,
       for (std::size_t xx = x > 0 ? x - 1 : x; xx <= std::min(x + 1, w - 1); ++xx)
         if (yy != y || xx != x)
           n[count++] = in_range(depth[yy * w + xx]);
-    out[y * w + x] = keep(in_range(depth[y * w + x]), n, count);
+    out[y * w + x] =
+        keepPixel(in_range(depth[y * w + x]), n, count, lo_factor, hi_factor);
   };
   forEachStripe(h, threads_, [&](std::size_t row_begin, std::size_t row_end) {
     // The in-range depths of rows y - 1, y and y + 1, in a ring of three rows.
@@ -167,12 +210,7 @@ DepthPreprocessing::apply(const std::vector<float>& depth,
       const float* up = ring.data() + ((y - 1) % 3) * w;
       const float* mid = ring.data() + (y % 3) * w;
       const float* down = ring.data() + ((y + 1) % 3) * w;
-      float* dst = out.data() + y * w;
-      for (std::size_t x = 1; x + 1 < w; ++x) {
-        const float n[8] = {up[x - 1],  up[x],       up[x + 1], mid[x - 1],
-                            mid[x + 1], down[x - 1], down[x],   down[x + 1]};
-        dst[x] = keep(mid[x], n, 8);
-      }
+      keepInteriorRow(up, mid, down, out.data() + y * w, w, lo_factor, hi_factor);
       border_pixel(w - 1, y);
     }
   });
@@ -209,16 +247,8 @@ DepthPreprocessing::apply(const std::vector<float>& depth,
     for (std::size_t y = 0; y < h; ++y) {
       const float* row = out.data() + y * w + col_begin;
       const int yi = static_cast<int>(y);
-      int closing = 0;
-      for (std::size_t x = 0; x < cols; ++x) {
-        const bool valid = row[x] == row[x];
-        const int l = last[x];
-        const int gap = yi - l - 1;
-        const bool closes = valid & (gap >= 1) & (gap <= max_gap_rows);
-        gap_from[x] = closes ? l : -1;
-        closing += closes;
-        last[x] = valid ? yi : l;
-      }
+      int closing =
+          markClosingGaps(row, cols, yi, max_gap_rows, last.data(), gap_from.data());
       for (std::size_t x = 0; closing > 0 && x < cols; ++x) {
         const int l = gap_from[x];
         if (l < 0)
