@@ -85,7 +85,8 @@ makeTemplate256(Rows<std::uint8_t> image,
       _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + x),
                           greyRow(src + x, image.step, pw));
       // The gradients of 8 pixels at a time: pixels 0-3 in the low lane, 4-7 in the high.
-      for (int part = 0; part < 2; ++part, dsrc += 16, dout += 16) {
+      __m256i parts[2];
+      for (int part = 0; part < 2; ++part, dsrc += 16) {
         const auto load = [](const short* p) {
           return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p));
         };
@@ -103,7 +104,7 @@ makeTemplate256(Rows<std::uint8_t> image,
         const __m256i g =
             _mm256_packs_epi32(_mm256_srai_epi32(low, W_BITS),
                                _mm256_srai_epi32(high, W_BITS)); // Ix Iy ...
-        _mm256_storeu_si256(reinterpret_cast<__m256i*>(dout), g);
+        parts[part] = g;
         const __m256 fx =
             _mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(g, 16), 16));
         const __m256 fy = _mm256_cvtepi32_ps(_mm256_srai_epi32(g, 16));
@@ -113,6 +114,16 @@ makeTemplate256(Rows<std::uint8_t> image,
         A12 = addHalves(A12, _mm256_mul_ps(fx, fy));
         A11 = addHalves(A11, _mm256_mul_ps(fx, fx));
       }
+      // Kept in the order mismatch256() pairs them with the grey levels: for pixels 0-7 in
+      // the low lane and 8-15 in the high, (Ix_k, Ix_k+4, Iy_k, Iy_k+4) for k = 0, 1, then
+      // for k = 2, 3 (the 128-bit kernel's pairs), so that its steps need not shuffle them.
+      const __m256i first = _mm256_permute2x128_si256(parts[0], parts[1], 0x20);
+      const __m256i second = _mm256_permute2x128_si256(parts[0], parts[1], 0x31);
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(dout),
+                          _mm256_unpacklo_epi16(first, second));
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(dout + 16),
+                          _mm256_unpackhi_epi16(first, second));
+      dout += 32;
     }
   }
   return {reduceSum(A11) * FLT_SCALE, reduceSum(A12) * FLT_SCALE,
@@ -127,6 +138,13 @@ mismatch256(Rows<std::uint8_t> image,
             const short* window_gradient)
 {
   const PairWeights pw = pairWeights(w);
+  // Bytes of 16-bit lanes (0, 4, 0, 4, 1, 5, 1, 5) and (2, 6, 2, 6, 3, 7, 3, 7) of each half.
+  const __m256i PAIRS_01 =
+      _mm256_setr_epi8(0, 1, 8, 9, 0, 1, 8, 9, 2, 3, 10, 11, 2, 3, 10, 11, 0, 1, 8, 9,
+                       0, 1, 8, 9, 2, 3, 10, 11, 2, 3, 10, 11);
+  const __m256i PAIRS_23 =
+      _mm256_setr_epi8(4, 5, 12, 13, 4, 5, 12, 13, 6, 7, 14, 15, 6, 7, 14, 15, 4, 5, 12,
+                       13, 4, 5, 12, 13, 6, 7, 14, 15, 6, 7, 14, 15);
   __m128 b0 = _mm_setzero_ps(), b1 = _mm_setzero_ps();
   for (int y = 0; y < window; ++y) {
     const std::uint8_t* src = image.origin + y * image.step;
@@ -136,21 +154,18 @@ mismatch256(Rows<std::uint8_t> image,
       const __m256i diff = _mm256_subs_epi16(
           greyRow(src + x, image.step, pw),
           _mm256_loadu_si256(reinterpret_cast<const __m256i*>(Iptr + x)));
-      // The 128-bit kernel's pairing, for pixels 0-7 in the low lane and 8-15 in the high:
-      // (It_k, It_k+4) against (Ix_k, Ix_k+4) and (Iy_k, Iy_k+4).
-      const __m256i twice_low = _mm256_unpacklo_epi16(diff, diff);
-      const __m256i twice_high = _mm256_unpackhi_epi16(diff, diff);
-      const __m256i g0 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(dIptr));
-      const __m256i g1 =
-          _mm256_loadu_si256(reinterpret_cast<const __m256i*>(dIptr + 16));
-      const __m256i first = _mm256_permute2x128_si256(g0, g1, 0x20);
-      const __m256i second = _mm256_permute2x128_si256(g0, g1, 0x31);
-      b0 = addHalves(b0, _mm256_cvtepi32_ps(_mm256_madd_epi16(
-                             _mm256_unpacklo_epi16(twice_low, twice_high),
-                             _mm256_unpacklo_epi16(first, second))));
-      b1 = addHalves(b1, _mm256_cvtepi32_ps(_mm256_madd_epi16(
-                             _mm256_unpackhi_epi16(twice_low, twice_high),
-                             _mm256_unpackhi_epi16(first, second))));
+      // The 128-bit kernel's pairs, for pixels 0-7 in the low lane and 8-15 in the high:
+      // (It_k, It_k+4) against the template's (Ix_k, Ix_k+4) and (Iy_k, Iy_k+4).
+      const __m256i pairs_01 = _mm256_shuffle_epi8(diff, PAIRS_01);
+      const __m256i pairs_23 = _mm256_shuffle_epi8(diff, PAIRS_23);
+      b0 = addHalves(
+          b0,
+          _mm256_cvtepi32_ps(_mm256_madd_epi16(
+              pairs_01, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(dIptr)))));
+      b1 = addHalves(
+          b1, _mm256_cvtepi32_ps(_mm256_madd_epi16(
+                  pairs_23,
+                  _mm256_loadu_si256(reinterpret_cast<const __m256i*>(dIptr + 16)))));
     }
   }
   // OpenCV's epilogue: lanes (x, y, x, y) of b0 + b1, each pair of x and y summed.
