@@ -212,15 +212,26 @@ mismatch128(Rows<std::uint8_t> image,
   return {ib1 * FLT_SCALE, ib2 * FLT_SCALE};
 }
 
-/// The rows of a pyramid level's image or gradients from the window corner (x, y).
-template <typename T>
-Rows<T>
-rowsAt(const cv::Mat& m, cv::Point2i corner, int channels)
-{
-  const std::ptrdiff_t step = static_cast<std::ptrdiff_t>(m.step / m.elemSize1());
-  return {reinterpret_cast<const T*>(m.data) + corner.y * step + corner.x * channels,
-          step};
-}
+/// A pyramid level's image (or interleaved gradients) with its row step in elements, so
+/// that a window's rows cost no division.
+template <typename T> struct Plane {
+  const T* data;
+  std::ptrdiff_t step;
+  int channels;
+
+  explicit Plane(const cv::Mat& m)
+      : data(reinterpret_cast<const T*>(m.data))
+      , step(static_cast<std::ptrdiff_t>(m.step / m.elemSize1()))
+      , channels(m.channels())
+  {
+  }
+
+  /// The rows of the window whose top-left pixel is `corner`.
+  Rows<T> at(cv::Point2i corner) const
+  {
+    return {data + corner.y * step + corner.x * channels, step};
+  }
+};
 
 /// Whether the 256-bit kernels run: built for x86-64, the CPU has AVX2, and the window's
 /// rows are whole multiples of 16 pixels.
@@ -262,10 +273,17 @@ trackLucasKanade(const std::vector<cv::Mat>& from_pyramid,
   std::vector<short> gradient(grey.size() * 2);
   const bool wide = wideKernels(s);
 
+  std::vector<Plane<std::uint8_t>> images, targets;
+  std::vector<Plane<short>> gradients;
+  for (int level = 0; level <= max_level; ++level) {
+    images.emplace_back(from_pyramid[2 * level]);
+    gradients.emplace_back(from_pyramid[2 * level + 1]);
+    targets.emplace_back(to_pyramid[2 * level]);
+  }
+
   status.assign(from.size(), 1);
   for (std::size_t i = 0; i < from.size(); ++i) {
     for (int level = max_level; level >= 0; --level) {
-      const cv::Mat& I = from_pyramid[2 * level];
       const cv::Mat& dI = from_pyramid[2 * level + 1];
       const cv::Mat& J = to_pyramid[2 * level];
       cv::Point2f prev = from[i] * static_cast<float>(1. / (1 << level));
@@ -281,8 +299,8 @@ trackLucasKanade(const std::vector<cv::Mat>& from_pyramid,
           status[i] = 0;
         continue;
       }
-      const Rows<std::uint8_t> image = rowsAt<std::uint8_t>(I, iprev, 1);
-      const Rows<short> image_gradient = rowsAt<short>(dI, iprev, 2);
+      const Rows<std::uint8_t> image = images[level].at(iprev);
+      const Rows<short> image_gradient = gradients[level].at(iprev);
       const Weights w = weightsOf(prev.x - iprev.x, prev.y - iprev.y);
       const auto [A11, A12, A22] =
           wide ? lk::makeTemplate256(image, image_gradient, w, window, grey.data(),
@@ -309,7 +327,7 @@ trackLucasKanade(const std::vector<cv::Mat>& from_pyramid,
             status[i] = 0;
           break;
         }
-        const Rows<std::uint8_t> target = rowsAt<std::uint8_t>(J, inext, 1);
+        const Rows<std::uint8_t> target = targets[level].at(inext);
         const Weights wn = weightsOf(next.x - inext.x, next.y - inext.y);
         const auto [b1, b2] =
             wide ? lk::mismatch256(target, wn, window, grey.data(), gradient.data())
