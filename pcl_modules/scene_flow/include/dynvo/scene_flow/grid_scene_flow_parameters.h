@@ -33,9 +33,9 @@ struct DYNVO_EXPORTS GridSceneFlowParameters {
   int cell_size = 16;
   /// z_min, z_max, tau_fly, w_hole, tau_fill (docs/algorithm.md §1.1).
   DepthPreprocessing::Parameters depth;
-  /// LK win (px, >= 3): side of the square LK window (paper: 21). 16 because OpenCV's LK
-  /// works on rows in steps of 8 pixels and does the rest one by one: 16 costs less than 13
-  /// (docs/algorithm.md §1.2).
+  /// LK win (px, >= 3): side of the square LK window (paper: 21). 16 because LK works on
+  /// rows in steps of 16 pixels (AVX2) or 8 and does the rest one by one: 16 costs less
+  /// than 13 (docs/algorithm.md §1.2).
   int window_size = 16;
   /// LK levels (>= 0): OpenCV maxLevel, 0 = no pyramid (paper: 3).
   int max_pyramid_level = 2;
