@@ -4,6 +4,7 @@
 #include <dynvo/registration/direct_odometry.h>
 
 #include <dynvo/common/parallel.h>
+#include <dynvo/common/vectorize.h>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
@@ -156,6 +157,34 @@ struct StaticLookup {
   }
 };
 
+/** Marks the pixels x = 1, 1 + step, ... < width - 1 of a row that can be samples (taken[k]
+ * for the k-th): a depth in (0, max_depth], a central-difference gradient of at least
+ * MIN_GRADIENT grey levels per pixel, a static column. Returns how many were scanned.
+ * Branch-free, and built for AVX2 as well (the same comparisons and products).
+ */
+DYNVO_VECTORIZE_FOR_AVX2 int
+markSamples(const float* up,
+            const float* row,
+            const float* down,
+            const float* depth,
+            const std::uint8_t* static_columns,
+            int width,
+            int step,
+            float max_depth,
+            std::uint8_t* taken)
+{
+  int k = 0;
+  for (int x = 1; x + 1 < width; x += step, ++k) {
+    const float z = depth[x];
+    const float gx = row[x + 1] - row[x - 1];
+    const float gy = down[x] - up[x];
+    taken[k] = (z > 0.0f) & (z <= max_depth) &
+               (gx * gx + gy * gy >= 4.0f * MIN_GRADIENT * MIN_GRADIENT) &
+               (static_columns[x] != 0);
+  }
+  return k;
+}
+
 template <typename Level>
 std::vector<Sample>
 samplesOf(const Level& level,
@@ -164,13 +193,15 @@ samplesOf(const Level& level,
           float max_depth)
 {
   // The textured static pixels with depth (y * width + x), then at most BUDGET of them
-  // evenly spread. The scan writes every pixel and keeps the ones taken: no branch per pixel.
+  // evenly spread. Each row is marked (markSamples()), then every scanned pixel written and
+  // the ones taken kept: no branch per pixel.
   const int step = level.scale == 1 ? FINE_STEP : 1;
   const int size = static_cast<int>(cells.cell_size);
   std::vector<int> pixels(static_cast<std::size_t>(level.width / step + 1) *
                           (level.height / step + 1));
   std::size_t found = 0;
   std::vector<std::uint8_t> static_columns(static_cast<std::size_t>(level.width));
+  std::vector<std::uint8_t> taken(static_cast<std::size_t>(level.width));
   int columns_row = -1; // the cell row static_columns holds
   for (int y = 1; y + 1 < level.height; y += step) {
     const int cell_row = y * level.scale / size;
@@ -186,18 +217,13 @@ samplesOf(const Level& level,
       }
       columns_row = cell_row;
     }
-    const float* row = level.grey.template ptr<float>(y);
-    const float* up = level.grey.template ptr<float>(y - 1);
-    const float* down = level.grey.template ptr<float>(y + 1);
-    const float* depth = level.depth.template ptr<float>(y);
-    for (int x = 1; x + 1 < level.width; x += step) {
-      const float z = depth[x];
-      const float gx = row[x + 1] - row[x - 1];
-      const float gy = down[x] - up[x];
-      pixels[found] = y * level.width + x;
-      found += (z > 0.0f) & (z <= max_depth) &
-               (gx * gx + gy * gy >= 4.0f * MIN_GRADIENT * MIN_GRADIENT) &
-               (static_columns[x] != 0);
+    const int scanned = markSamples(
+        level.grey.template ptr<float>(y - 1), level.grey.template ptr<float>(y),
+        level.grey.template ptr<float>(y + 1), level.depth.template ptr<float>(y),
+        static_columns.data(), level.width, step, max_depth, taken.data());
+    for (int k = 0; k < scanned; ++k) {
+      pixels[found] = y * level.width + 1 + k * step;
+      found += taken[static_cast<std::size_t>(k)];
     }
   }
   pixels.resize(found);
