@@ -94,6 +94,15 @@ windowDepth(const std::vector<float>& depth,
   const int u0 = static_cast<int>(std::lround(p.x));
   const int v0 = static_cast<int>(std::lround(p.y));
   const float tolerance = tau_edge * z_point;
+  // The window's rows are requested from memory together before the first is read: the
+  // depth maps are read a frame after they were made, and a row at a time the loop would
+  // wait for each.
+  for (int v = std::max(v0 - radius, 0); v <= std::min(v0 + radius, height - 1);
+       v += WINDOW_STEP) {
+    const float* row = depth.data() + static_cast<std::size_t>(v) * width;
+    __builtin_prefetch(row + std::max(u0 - radius, 0));
+    __builtin_prefetch(row + std::min(u0 + radius, width - 1));
+  }
   double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0, sw = 0, swx = 0, swy = 0;
   for (int v = v0 - radius; v <= v0 + radius; v += WINDOW_STEP) {
     if (v < 0 || v >= height)
