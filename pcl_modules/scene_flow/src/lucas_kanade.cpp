@@ -39,6 +39,38 @@ weightsOf(float a, float b)
   return w;
 }
 
+#if CV_SIMD128
+/// (a, b) in every pair of 16-bit lanes, for v_dotprod.
+cv::v_int16x8
+pairOf(int a, int b)
+{
+  return cv::v_reinterpret_as_s16(cv::v_setall_u32(static_cast<unsigned>(a & 0xffff) |
+                                                   static_cast<unsigned>(b) << 16));
+}
+#endif
+
+#if CV_SIMD128
+/// 8 grey levels x 32 at a row of an 8-bit image, bilinear (qw0, qw1: pairOf() the weights).
+cv::v_int16x8
+greyRow128(const std::uint8_t* row,
+           std::ptrdiff_t step,
+           const cv::v_int16x8& qw0,
+           const cv::v_int16x8& qw1)
+{
+  const cv::v_int16x8 v00 = cv::v_reinterpret_as_s16(cv::v_load_expand(row));
+  const cv::v_int16x8 v01 = cv::v_reinterpret_as_s16(cv::v_load_expand(row + 1));
+  const cv::v_int16x8 v10 = cv::v_reinterpret_as_s16(cv::v_load_expand(row + step));
+  const cv::v_int16x8 v11 = cv::v_reinterpret_as_s16(cv::v_load_expand(row + step + 1));
+  cv::v_int16x8 t00, t01, t10, t11;
+  cv::v_zip(v00, v01, t00, t01);
+  cv::v_zip(v10, v11, t10, t11);
+  const cv::v_int32x4 round = cv::v_setall_s32(1 << (W_BITS - 5 - 1));
+  const cv::v_int32x4 t0 = cv::v_dotprod(t00, qw0, round) + cv::v_dotprod(t10, qw1);
+  const cv::v_int32x4 t1 = cv::v_dotprod(t01, qw0, round) + cv::v_dotprod(t11, qw1);
+  return cv::v_pack(t0 >> (W_BITS - 5), t1 >> (W_BITS - 5));
+}
+#endif
+
 /** The template of a window (128-bit integer arithmetic, OpenCV's code path): grey levels
  * x 32 into `grey`, interleaved gradients into `window_gradient`, and their normal matrix. */
 Normal
@@ -53,16 +85,8 @@ makeTemplate128(Rows<std::uint8_t> image,
   const std::ptrdiff_t step_d = gradient.step;
   float iA11 = 0, iA12 = 0, iA22 = 0;
 #if CV_SIMD128
-  const cv::v_int16x8 qw0(static_cast<short>(w.w00), static_cast<short>(w.w01),
-                          static_cast<short>(w.w00), static_cast<short>(w.w01),
-                          static_cast<short>(w.w00), static_cast<short>(w.w01),
-                          static_cast<short>(w.w00), static_cast<short>(w.w01));
-  const cv::v_int16x8 qw1(static_cast<short>(w.w10), static_cast<short>(w.w11),
-                          static_cast<short>(w.w10), static_cast<short>(w.w11),
-                          static_cast<short>(w.w10), static_cast<short>(w.w11),
-                          static_cast<short>(w.w10), static_cast<short>(w.w11));
+  const cv::v_int16x8 qw0 = pairOf(w.w00, w.w01), qw1 = pairOf(w.w10, w.w11);
   const cv::v_int32x4 round_d = cv::v_setall_s32(1 << (W_BITS - 1));
-  const cv::v_int32x4 round_i = cv::v_setall_s32(1 << (W_BITS - 5 - 1));
   cv::v_float32x4 qA11 = cv::v_setzero_f32(), qA12 = cv::v_setzero_f32(),
                   qA22 = cv::v_setzero_f32();
 #endif
@@ -74,33 +98,17 @@ makeTemplate128(Rows<std::uint8_t> image,
     int x = 0;
 #if CV_SIMD128
     for (; x <= window - 8; x += 8, dsrc += 16, dIptr += 16) {
-      cv::v_int16x8 v00 = cv::v_reinterpret_as_s16(cv::v_load_expand(src + x));
-      cv::v_int16x8 v01 = cv::v_reinterpret_as_s16(cv::v_load_expand(src + x + 1));
-      cv::v_int16x8 v10 = cv::v_reinterpret_as_s16(cv::v_load_expand(src + x + step_i));
-      cv::v_int16x8 v11 =
-          cv::v_reinterpret_as_s16(cv::v_load_expand(src + x + step_i + 1));
-      cv::v_int16x8 t00, t01, t10, t11;
-      cv::v_zip(v00, v01, t00, t01);
-      cv::v_zip(v10, v11, t10, t11);
-      cv::v_int32x4 t0 = cv::v_dotprod(t00, qw0, round_i) + cv::v_dotprod(t10, qw1);
-      cv::v_int32x4 t1 = cv::v_dotprod(t01, qw0, round_i) + cv::v_dotprod(t11, qw1);
-      t0 = t0 >> (W_BITS - 5);
-      t1 = t1 >> (W_BITS - 5);
-      cv::v_store(Iptr + x, cv::v_pack(t0, t1));
+      cv::v_store(Iptr + x, greyRow128(src + x, step_i, qw0, qw1));
       // The gradients of the 8 pixels, 4 at a time (OpenCV's order of the sums).
       for (int half = 0; half < 2; ++half) {
         const short* d = dsrc + half * 8;
-        v00 = cv::v_load(d);
-        v01 = cv::v_load(d + 2);
-        v10 = cv::v_load(d + step_d);
-        v11 = cv::v_load(d + step_d + 2);
-        cv::v_zip(v00, v01, t00, t01);
-        cv::v_zip(v10, v11, t10, t11);
-        t0 = cv::v_dotprod(t00, qw0, round_d) + cv::v_dotprod(t10, qw1);
-        t1 = cv::v_dotprod(t01, qw0, round_d) + cv::v_dotprod(t11, qw1);
-        t0 = t0 >> W_BITS;
-        t1 = t1 >> W_BITS;
-        v00 = cv::v_pack(t0, t1); // Ix0 Iy0 Ix1 Iy1 ...
+        cv::v_int16x8 t00, t01, t10, t11;
+        cv::v_zip(cv::v_load(d), cv::v_load(d + 2), t00, t01);
+        cv::v_zip(cv::v_load(d + step_d), cv::v_load(d + step_d + 2), t10, t11);
+        cv::v_int32x4 t0 = cv::v_dotprod(t00, qw0, round_d) + cv::v_dotprod(t10, qw1);
+        cv::v_int32x4 t1 = cv::v_dotprod(t01, qw0, round_d) + cv::v_dotprod(t11, qw1);
+        cv::v_int16x8 v00 =
+            cv::v_pack(t0 >> W_BITS, t1 >> W_BITS); // Ix0 Iy0 Ix1 Iy1 ...
         cv::v_store(dIptr + half * 8, v00);
         v00 = cv::v_reinterpret_as_s16(cv::v_interleave_pairs(
             cv::v_reinterpret_as_s32(cv::v_interleave_pairs(v00))));
@@ -151,15 +159,7 @@ mismatch128(Rows<std::uint8_t> image,
   const std::ptrdiff_t step_j = image.step;
   float ib1 = 0, ib2 = 0;
 #if CV_SIMD128
-  const cv::v_int16x8 qw0(static_cast<short>(w.w00), static_cast<short>(w.w01),
-                          static_cast<short>(w.w00), static_cast<short>(w.w01),
-                          static_cast<short>(w.w00), static_cast<short>(w.w01),
-                          static_cast<short>(w.w00), static_cast<short>(w.w01));
-  const cv::v_int16x8 qw1(static_cast<short>(w.w10), static_cast<short>(w.w11),
-                          static_cast<short>(w.w10), static_cast<short>(w.w11),
-                          static_cast<short>(w.w10), static_cast<short>(w.w11),
-                          static_cast<short>(w.w10), static_cast<short>(w.w11));
-  const cv::v_int32x4 round_i = cv::v_setall_s32(1 << (W_BITS - 5 - 1));
+  const cv::v_int16x8 qw0 = pairOf(w.w00, w.w01), qw1 = pairOf(w.w10, w.w11);
   cv::v_float32x4 qb0 = cv::v_setzero_f32(), qb1 = cv::v_setzero_f32();
 #endif
   for (int y = 0; y < window; ++y) {
@@ -169,24 +169,12 @@ mismatch128(Rows<std::uint8_t> image,
     int x = 0;
 #if CV_SIMD128
     for (; x <= window - 8; x += 8, dIptr += 16) {
-      cv::v_int16x8 diff0 = cv::v_load(Iptr + x), diff1, diff2;
-      cv::v_int16x8 v00 = cv::v_reinterpret_as_s16(cv::v_load_expand(Jptr + x));
-      cv::v_int16x8 v01 = cv::v_reinterpret_as_s16(cv::v_load_expand(Jptr + x + 1));
-      cv::v_int16x8 v10 =
-          cv::v_reinterpret_as_s16(cv::v_load_expand(Jptr + x + step_j));
-      cv::v_int16x8 v11 =
-          cv::v_reinterpret_as_s16(cv::v_load_expand(Jptr + x + step_j + 1));
-      cv::v_int16x8 t00, t01, t10, t11;
-      cv::v_zip(v00, v01, t00, t01);
-      cv::v_zip(v10, v11, t10, t11);
-      cv::v_int32x4 t0 = cv::v_dotprod(t00, qw0, round_i) + cv::v_dotprod(t10, qw1);
-      cv::v_int32x4 t1 = cv::v_dotprod(t01, qw0, round_i) + cv::v_dotprod(t11, qw1);
-      t0 = t0 >> (W_BITS - 5);
-      t1 = t1 >> (W_BITS - 5);
-      diff0 = cv::v_pack(t0, t1) - diff0;
+      cv::v_int16x8 diff1, diff2;
+      const cv::v_int16x8 diff0 =
+          greyRow128(Jptr + x, step_j, qw0, qw1) - cv::v_load(Iptr + x);
       cv::v_zip(diff0, diff0, diff2, diff1); // It0 It0 It1 It1 ...
-      v00 = cv::v_load(dIptr);               // Ix0 Iy0 Ix1 Iy1 ...
-      v01 = cv::v_load(dIptr + 8);
+      cv::v_int16x8 v00 = cv::v_load(dIptr); // Ix0 Iy0 Ix1 Iy1 ...
+      cv::v_int16x8 v01 = cv::v_load(dIptr + 8), v10, v11;
       cv::v_zip(v00, v01, v10, v11);
       cv::v_zip(diff2, diff1, v00, v01);
       qb0 += cv::v_cvt_f32(cv::v_dotprod(v00, v10));
