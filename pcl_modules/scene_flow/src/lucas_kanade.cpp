@@ -47,9 +47,7 @@ pairOf(int a, int b)
   return cv::v_reinterpret_as_s16(cv::v_setall_u32(static_cast<unsigned>(a & 0xffff) |
                                                    static_cast<unsigned>(b) << 16));
 }
-#endif
 
-#if CV_SIMD128
 /// 8 grey levels x 32 at a row of an 8-bit image, bilinear (qw0, qw1: pairOf() the weights).
 cv::v_int16x8
 greyRow128(const std::uint8_t* row,
