@@ -4,8 +4,6 @@
 #include "../../pcl_modules/scene_flow/src/lucas_kanade.h"
 #include "real_frames.h"
 
-#include <dynvo/common/image.h>
-
 #include <opencv2/core/utility.hpp>
 #include <opencv2/video/tracking.hpp>
 
@@ -26,13 +24,11 @@ pyramids()
   static const std::vector<std::vector<cv::Mat>> built = [] {
     std::vector<std::vector<cv::Mat>> result;
     for (const dynvo::Frame& frame : frames()) {
-      const auto& cloud = *frame.cloud;
-      cv::Mat grey(static_cast<int>(cloud.height), static_cast<int>(cloud.width),
-                   CV_8UC1);
-      for (std::size_t i = 0; i < cloud.size(); ++i)
-        grey.data[i] = dynvo::luma(cloud[i].r, cloud[i].g, cloud[i].b);
+      std::vector<std::uint8_t> grey = dynvo::bench::greyOf(frame);
+      const cv::Mat image(static_cast<int>(frame.cloud->height),
+                          static_cast<int>(frame.cloud->width), CV_8UC1, grey.data());
       result.emplace_back();
-      cv::buildOpticalFlowPyramid(grey, result.back(), cv::Size(16, 16), 2, true);
+      cv::buildOpticalFlowPyramid(image, result.back(), cv::Size(16, 16), 2, true);
     }
     return result;
   }();
@@ -61,27 +57,31 @@ BM_LucasKanadeFramePair(benchmark::State& state)
   // One thread, as the grid runs each of its stripes (OpenCV would share one call out).
   const int threads = cv::getNumThreads();
   cv::setNumThreads(1);
-  std::vector<cv::Point2f> tracked, back;
   std::vector<std::uint8_t> status;
+  // The implementation the argument names, from the guesses in `out`.
+  const auto track = [&](const std::vector<cv::Mat>& from_pyramid,
+                         const std::vector<cv::Mat>& to_pyramid,
+                         const std::vector<cv::Point2f>& points,
+                         const dynvo::detail::LucasKanadeSettings& s,
+                         std::vector<cv::Point2f>& out) {
+    if (state.range(0) == 0)
+      cv::calcOpticalFlowPyrLK(from_pyramid, to_pyramid, points, out, status,
+                               cv::noArray(), cv::Size(s.window, s.window), s.max_level,
+                               criteria, cv::OPTFLOW_USE_INITIAL_FLOW,
+                               s.min_eigen_threshold);
+    else
+      dynvo::detail::trackLucasKanade(from_pyramid, to_pyramid, points, s, out, status);
+  };
+  std::vector<cv::Point2f> tracked, back;
   std::size_t step = 0;
   for (auto _ : state) {
     const auto& from = pyramids()[pingPong(step + 1, n)];
     const auto& to = pyramids()[pingPong(step, n)];
     ++step;
     tracked = centres;
-    if (state.range(0) == 0)
-      cv::calcOpticalFlowPyrLK(from, to, centres, tracked, status, cv::noArray(),
-                               cv::Size(16, 16), 2, criteria,
-                               cv::OPTFLOW_USE_INITIAL_FLOW);
-    else
-      dynvo::detail::trackLucasKanade(from, to, centres, forward, tracked, status);
+    track(from, to, centres, forward, tracked);
     back = centres;
-    if (state.range(0) == 0)
-      cv::calcOpticalFlowPyrLK(to, from, tracked, back, status, cv::noArray(),
-                               cv::Size(16, 16), 0, criteria,
-                               cv::OPTFLOW_USE_INITIAL_FLOW);
-    else
-      dynvo::detail::trackLucasKanade(to, from, tracked, backward, back, status);
+    track(to, from, tracked, backward, back);
     benchmark::DoNotOptimize(back.data());
   }
   cv::setNumThreads(threads);

@@ -30,10 +30,9 @@ greyDepths()
     std::vector<GreyDepth> result;
     for (const dynvo::Frame& frame : frames()) {
       GreyDepth& out = result.emplace_back();
-      for (const pcl::PointXYZRGB& p : *frame.cloud) {
-        out.grey.push_back(dynvo::luma(p.r, p.g, p.b));
+      out.grey = dynvo::bench::greyOf(frame);
+      for (const pcl::PointXYZRGB& p : *frame.cloud)
         out.depth.push_back(p.z);
-      }
     }
     return result;
   }();

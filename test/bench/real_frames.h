@@ -2,11 +2,13 @@
 // The real frames the benchmarks run on: the first frames of the shared tum_fr1_xyz_200 clip.
 #pragma once
 
+#include <dynvo/common/image.h>
 #include <dynvo/io/tum_folder_source.h>
 
 #include <benchmark/benchmark.h>
 
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -32,6 +34,17 @@ frames()
     return result;
   }();
   return loaded;
+}
+
+/// A frame's grey levels (luma of its cloud's colours), row-major, as the pipeline reads them.
+inline std::vector<std::uint8_t>
+greyOf(const Frame& frame)
+{
+  std::vector<std::uint8_t> grey;
+  grey.reserve(frame.cloud->size());
+  for (const auto& p : *frame.cloud)
+    grey.push_back(luma(p.r, p.g, p.b));
+  return grey;
 }
 
 /// Frame order 0, 1, ..., N-1, N-2, ..., 1, 0, 1, ...: every step is a real consecutive pair.

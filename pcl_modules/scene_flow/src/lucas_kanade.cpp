@@ -267,6 +267,12 @@ trackLucasKanade(const std::vector<cv::Mat>& from_pyramid,
     targets.emplace_back(to_pyramid[2 * level]);
   }
 
+  // A window whose top-left corner lies farther than a window off the level (OpenCV's rule:
+  // the pyramid's border is a window wide).
+  const auto offLevel = [window](cv::Point2i corner, const cv::Mat& level) {
+    return corner.x < -window || corner.x >= level.cols || corner.y < -window ||
+           corner.y >= level.rows;
+  };
   status.assign(from.size(), 1);
   for (std::size_t i = 0; i < from.size(); ++i) {
     for (int level = max_level; level >= 0; --level) {
@@ -279,8 +285,7 @@ trackLucasKanade(const std::vector<cv::Mat>& from_pyramid,
       to[i] = next;
       prev -= half_window;
       const cv::Point2i iprev(cvFloor(prev.x), cvFloor(prev.y));
-      if (iprev.x < -window || iprev.x >= dI.cols || iprev.y < -window ||
-          iprev.y >= dI.rows) {
+      if (offLevel(iprev, dI)) {
         if (level == 0)
           status[i] = 0;
         continue;
@@ -307,8 +312,7 @@ trackLucasKanade(const std::vector<cv::Mat>& from_pyramid,
       cv::Point2f previous_delta;
       for (int j = 0; j < max_iterations; ++j) {
         const cv::Point2i inext(cvFloor(next.x), cvFloor(next.y));
-        if (inext.x < -window || inext.x >= J.cols || inext.y < -window ||
-            inext.y >= J.rows) {
+        if (offLevel(inext, J)) {
           if (level == 0)
             status[i] = 0;
           break;
