@@ -7,7 +7,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cstddef>
+#include <future>
 #include <mutex>
+#include <stdexcept>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -81,6 +83,49 @@ TEST(ForEachStripe, OneThreadKeepsOpenCVsOwnLoopsOnIt)
   ASSERT_EQ(seen.size(), 64u);
   for (const std::thread::id& id : seen)
     EXPECT_EQ(id, std::this_thread::get_id());
+}
+
+TEST(TaskThread, RunsTasksInTurnBesideTheCaller)
+{
+  // The pipeline hands its backend inputs, then its pixel stage, to one kept thread: they
+  // must run off the caller's thread, one after the other in the order handed over, each
+  // result (or exception) reaching its own future.
+  dynvo::TaskThread worker;
+  std::vector<int> order; // written by the worker only
+  std::promise<void> release;
+  std::shared_future<void> released = release.get_future().share();
+  auto first = worker.run([&] {
+    released.wait(); // the caller queues the others meanwhile
+    order.push_back(1);
+    return std::this_thread::get_id();
+  });
+  auto second = worker.run([&] {
+    order.push_back(2);
+    return 2.5;
+  });
+  auto third = worker.run([&]() -> int {
+    order.push_back(3);
+    throw std::runtime_error("a failing task");
+  });
+  release.set_value();
+  EXPECT_NE(first.get(), std::this_thread::get_id());
+  EXPECT_EQ(second.get(), 2.5);
+  EXPECT_THROW(third.get(), std::runtime_error);
+  EXPECT_EQ(order, (std::vector<int>{1, 2, 3}));
+}
+
+TEST(TaskThread, DestructorRunsWhatWasHandedOver)
+{
+  // The pipeline's members outlive its worker: a task still queued at the end must run
+  // before the thread is joined, not be dropped with its future's waiter left hanging.
+  std::future<int> late;
+  {
+    dynvo::TaskThread worker;
+    worker.run([] { std::this_thread::sleep_for(std::chrono::milliseconds(20)); });
+    late = worker.run([] { return 7; });
+  }
+  ASSERT_EQ(late.wait_for(std::chrono::seconds(0)), std::future_status::ready);
+  EXPECT_EQ(late.get(), 7);
 }
 
 } // namespace

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <dynvo/app/odometry_pipeline.h>
+#include <dynvo/common/parallel.h>
 #include <dynvo/common/rigid_fit.h>
 #include <dynvo/common/trajectory.h>
 #include <dynvo/io/label_io.h>
@@ -160,9 +161,7 @@ struct OdometryPipeline::Impl {
     flow_estimation.setNumberOfThreads(options.threads);
     segmentation.setCameraIntrinsics(options.intrinsics);
     segmentation.setParameters(options.segmentation);
-    // The pixel stage runs beside the fits on the second thread (startSegments()); stripes of
-    // its own would only compete with them.
-    segmentation.setNumberOfThreads(1);
+    segmentation.setNumberOfThreads(options.threads);
     registration.setParameters(options.registration);
     keyframe_registration.setParameters(options.registration);
     const auto focal =
@@ -181,6 +180,8 @@ struct OdometryPipeline::Impl {
     dense.backend = RegistrationBackend::cv_rgbd;
     recovery.setParameters(dense);
     recovery.setCameraIntrinsics(options.intrinsics);
+    if (options.threads > 1)
+      worker = std::make_unique<TaskThread>();
   }
 
   /// Why the frame cannot be processed, or empty when it can.
@@ -361,8 +362,15 @@ struct OdometryPipeline::Impl {
       }
       return millisecondsSince(start);
     };
-    backend_inputs_ms = options.threads > 1 ? std::async(std::launch::async, inputs)
-                                            : std::async(std::launch::deferred, inputs);
+    backend_inputs_ms = start(inputs);
+  }
+
+  /// task on the second thread when there is one, else deferred until its future is read
+  template <typename Task>
+  std::future<double> start(Task task)
+  {
+    return worker ? worker->run(std::move(task))
+                  : std::async(std::launch::deferred, std::move(task));
   }
 
   /** The segmentation's pixel stage (pixel labels, indices, the label image): nothing the
@@ -378,8 +386,7 @@ struct OdometryPipeline::Impl {
       makeLabelImage();
       return millisecondsSince(start);
     };
-    segments_ms = options.threads > 1 ? std::async(std::launch::async, pixel_stage)
-                                      : std::async(std::launch::deferred, pixel_stage);
+    segments_ms = start(pixel_stage);
   }
 
   /** Waits for startSegments(); nothing before it may touch the segmentation or the segments
@@ -600,6 +607,8 @@ struct OdometryPipeline::Impl {
   double last_colour_dt = 1.0 / 30.0; ///< the last positive colour interval (s)
   std::size_t frames = 0;
   FrameResult result;
+  /// the second thread (threads > 1); last, so that it ends before the members its tasks use
+  std::unique_ptr<TaskThread> worker;
 };
 
 OdometryPipeline::OdometryPipeline(const PipelineOptions& options)

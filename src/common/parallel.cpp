@@ -28,4 +28,46 @@ forEachStripe(std::size_t n,
       static_cast<double>(stripes));
 }
 
+TaskThread::TaskThread()
+    : thread_([this] { loop(); })
+{
+}
+
+TaskThread::~TaskThread()
+{
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_one();
+  thread_.join();
+}
+
+void
+TaskThread::post(std::function<void()> job)
+{
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    jobs_.push_back(std::move(job));
+  }
+  wake_.notify_one();
+}
+
+void
+TaskThread::loop()
+{
+  for (;;) {
+    std::function<void()> job;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      wake_.wait(lock, [this] { return stop_ || !jobs_.empty(); });
+      if (jobs_.empty())
+        return; // stopped, nothing left
+      job = std::move(jobs_.front());
+      jobs_.pop_front();
+    }
+    job();
+  }
+}
+
 } // namespace dynvo

@@ -4,8 +4,15 @@
 
 #include <dynvo/common/export.h>
 
+#include <condition_variable>
 #include <cstddef>
+#include <deque>
 #include <functional>
+#include <future>
+#include <memory>
+#include <mutex>
+#include <thread>
+#include <type_traits>
 
 namespace dynvo {
 
@@ -27,5 +34,40 @@ DYNVO_EXPORTS void
 forEachStripe(std::size_t n,
               unsigned threads,
               const std::function<void(std::size_t, std::size_t)>& body);
+
+/** \brief One thread kept for the object's life, running the tasks handed to run() one after
+ * another beside the caller. std::async(std::launch::async) starts a thread per task, about
+ * 60 us of the caller's time on a 2-core VM (src/app/NOTES.md, twenty-third session); a pipeline
+ * that hands a task over twice per frame keeps this one instead. The destructor runs the tasks
+ * already handed over, then joins.
+ */
+class DYNVO_EXPORTS TaskThread {
+public:
+  TaskThread();
+  ~TaskThread();
+  TaskThread(const TaskThread&) = delete;
+  TaskThread& operator=(const TaskThread&) = delete;
+
+  /// Queues task; its result (or exception) arrives through the future.
+  template <typename Task>
+  std::future<std::invoke_result_t<Task>> run(Task task)
+  {
+    auto job = std::make_shared<std::packaged_task<std::invoke_result_t<Task>()>>(
+        std::move(task));
+    auto result = job->get_future();
+    post([job] { (*job)(); });
+    return result;
+  }
+
+private:
+  void post(std::function<void()> job);
+  void loop();
+
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::deque<std::function<void()>> jobs_;
+  bool stop_ = false;
+  std::thread thread_; ///< last: started once the members above exist
+};
 
 } // namespace dynvo

@@ -2,6 +2,7 @@
 // Two-frame rigid motion segmentation (docs/algorithm.md §3).
 #include <dynvo/motion_segmentation/spatial_segmentation.h>
 
+#include <dynvo/common/parallel.h>
 #include <dynvo/common/rigid_fit.h>
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include <limits>
 #include <numeric>
 #include <stdexcept>
+#include <utility>
 
 namespace dynvo {
 
@@ -52,6 +54,15 @@ collectInliers(const std::vector<float>& errors,
 }
 
 } // namespace
+
+void
+SpatialSegmenter::setNumberOfThreads(unsigned threads)
+{
+  if (threads == 0)
+    throw std::invalid_argument(
+        "[dynvo::SpatialSegmenter::setNumberOfThreads] need at least 1 thread, got 0");
+  threads_ = threads;
+}
 
 std::vector<int>
 dbscan(const std::vector<double>& distances, int count, double epsilon, int min_points)
@@ -226,12 +237,21 @@ SpatialSegmenter::clusterHypotheses(
   std::transform(w_.begin(), w_.end(), w.begin(), [](const Eigen::Matrix3f& m) {
     return m.cast<double>();
   });
+  // The h (h - 1) / 2 pairs, each a pass over two inlier lists (0.4 ms of a real frame), in
+  // stripes of pairs: every pair is computed alone, so the distances do not depend on them.
+  std::vector<std::pair<int, int>> pairs;
+  pairs.reserve(static_cast<std::size_t>(h) * (h - 1) / 2);
   for (int i = 0; i < h; ++i)
-    for (int j = i + 1; j < h; ++j) {
+    for (int j = i + 1; j < h; ++j)
+      pairs.emplace_back(i, j);
+  forEachStripe(pairs.size(), threads_, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t p = begin; p < end; ++p) {
+      const auto [i, j] = pairs[p];
       const double d = motionFieldDistance(accepted_[i], accepted_[j], a, w);
       distances[static_cast<std::size_t>(i) * h + j] = d;
       distances[static_cast<std::size_t>(j) * h + i] = d;
     }
+  });
   return dbscan(distances, h, th_.epsilon, params.dbscan_min_points);
 }
 

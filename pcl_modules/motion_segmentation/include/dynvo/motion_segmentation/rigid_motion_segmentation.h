@@ -202,9 +202,10 @@ public:
 
   const CameraIntrinsics& getCameraIntrinsics() const { return intrinsics_; }
 
-  /** \brief Worker threads (default 1) for the per-pixel index extraction; the per-cell
-   * stages take well under a millisecond and stay on the caller's thread. Results are
-   * identical for any count. \throws std::invalid_argument on 0
+  /** \brief Threads (default 1) for the hypotheses' pairwise distances and the per-pixel
+   * index extraction (dynvo::forEachStripe); the other per-cell loops take microseconds and
+   * stay on the caller's thread. Results are identical for any count.
+   * \throws std::invalid_argument on 0
    */
   void setNumberOfThreads(unsigned threads);
 

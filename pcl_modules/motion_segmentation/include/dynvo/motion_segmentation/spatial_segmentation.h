@@ -80,12 +80,15 @@ struct DYNVO_EXPORTS ResidualThresholds {
  * accepted when every sample point is an inlier, up to refine_iterations inlier/refit rounds,
  * the three stopping rules, DBSCAN with the motion-field distance, and labelling with
  * small-segment removal. The scratch buffers are kept between calls. Deterministic: the
- * result depends on the input and params only. Single-threaded on purpose: each per-cell
- * loop is a few microseconds, less than an OpenMP fork/join (measured: NOTES.md,
- * decision 11).
+ * result depends on the input and params only, not on the thread count: the per-cell loops
+ * (a few microseconds each) run on the caller's thread, only the hypotheses' pairwise
+ * distances go in stripes (NOTES.md, decision 11).
  */
 class DYNVO_EXPORTS SpatialSegmenter {
 public:
+  /// Threads (default 1) for the hypotheses' pairwise distances. \throws std::invalid_argument on 0
+  void setNumberOfThreads(unsigned threads);
+
   /** \param[in] grid scene flow of the frame pair, with information for the sensor model
    *  \param[in] params validated parameters
    *  \param[out] result labels per cell and one motion per segment (all 0 and no segment
@@ -134,6 +137,7 @@ private:
   using Draw = std::discrete_distribution<int>;
   std::mt19937 rng_; ///< sampling RNG
   Draw draw_;        ///< seed distribution S_k / sum S, rebuilt on acceptance
+  unsigned threads_ = 1; ///< setNumberOfThreads()
 };
 
 } // namespace dynvo

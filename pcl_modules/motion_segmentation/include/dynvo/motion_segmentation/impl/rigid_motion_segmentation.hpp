@@ -2,6 +2,7 @@
 // Template bodies of RigidMotionSegmentation (compiled in src/ for XYZRGB and XYZRGBA).
 #pragma once
 
+#include <dynvo/common/parallel.h>
 #include <dynvo/motion_segmentation/rigid_motion_segmentation.h>
 
 #include <pcl/console/print.h>
@@ -14,7 +15,6 @@
 #include <numeric>
 #include <stdexcept>
 #include <string>
-#include <thread>
 #include <utility>
 
 namespace dynvo {
@@ -69,6 +69,7 @@ RigidMotionSegmentation<PointT>::setNumberOfThreads(unsigned threads)
     throw std::invalid_argument("[dynvo::" + getClassName() +
                                 "::setNumberOfThreads] need at least 1 thread, got 0");
   threads_ = threads;
+  segmenter_.setNumberOfThreads(threads);
 }
 
 template <typename PointT>
@@ -161,16 +162,14 @@ RigidMotionSegmentation<PointT>::computeImplIndices(
     slot[segment_labels_[s]] = static_cast<int>(s);
   const int width = static_cast<int>(input_->width);
   const int height = static_cast<int>(input_->height);
-  // Stripes of pixel rows on their own threads, concatenated in order: the same indices
-  // for any thread count. Plain threads, not OpenMP: libgomp's spinning join costs more
-  // than this whole loop when other processes share the cores.
+  // Stripes of pixel rows, concatenated in order: the same indices for any thread count.
   const int stripes = std::max(1, std::min<int>(static_cast<int>(threads_), height));
   std::vector<std::vector<std::vector<int>>> parts(
       stripes, std::vector<std::vector<int>>(segment_labels_.size()));
-  const auto extract = [&](int stripe) {
+  const auto extract = [&](std::size_t stripe, std::size_t) {
     std::vector<std::vector<int>>& out = parts[stripe];
-    const int first = width * (height * stripe / stripes);
-    const int end = width * (height * (stripe + 1) / stripes);
+    const int first = width * (height * static_cast<int>(stripe) / stripes);
+    const int end = width * (height * (static_cast<int>(stripe) + 1) / stripes);
     // Runs of one label (most of a row is one segment): counted, then written as ranges.
     struct Run {
       int begin, end, segment;
@@ -199,12 +198,7 @@ RigidMotionSegmentation<PointT>::computeImplIndices(
                 run.begin);
     }
   };
-  std::vector<std::thread> workers;
-  for (int stripe = 1; stripe < stripes; ++stripe)
-    workers.emplace_back(extract, stripe);
-  extract(0);
-  for (std::thread& worker : workers)
-    worker.join();
+  forEachStripe(static_cast<std::size_t>(stripes), threads_, extract);
   segments.assign(segment_labels_.size(), pcl::PointIndices());
   for (std::size_t s = 0; s < segments.size(); ++s) {
     segments[s].header = input_->header;
