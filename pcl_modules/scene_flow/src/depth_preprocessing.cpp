@@ -153,6 +153,16 @@ DepthPreprocessing::apply(const std::vector<float>& depth,
                           std::uint32_t height,
                           std::vector<float>& out) const
 {
+  applyRows(depth, width, height, out);
+  applyColumns(width, height, out);
+}
+
+void
+DepthPreprocessing::applyRows(const std::vector<float>& depth,
+                              std::uint32_t width,
+                              std::uint32_t height,
+                              std::vector<float>& out) const
+{
   const std::size_t w = width;
   const std::size_t h = height;
   if (depth.size() != w * h)
@@ -186,6 +196,21 @@ DepthPreprocessing::apply(const std::vector<float>& depth,
     out[y * w + x] =
         keepPixel(in_range(depth[y * w + x]), n, count, lo_factor, hi_factor);
   };
+  // Step 3's row pass on row y reads and writes row y only: it follows the row's step 2.
+  const std::size_t max_gap = static_cast<std::size_t>(params_.max_hole_width);
+  const float tau_fill = params_.hole_fill_tolerance;
+  const auto fill_row = [&](std::size_t y) {
+    float* line = out.data() + y * w;
+    std::size_t last = w; // no valid pixel seen yet
+    for (std::size_t x = 0; x < w; ++x) {
+      if (std::isnan(line[x]))
+        continue;
+      if (last != w && x - last - 1 >= 1 && x - last - 1 <= max_gap &&
+          similar(line[last], line[x], tau_fill))
+        fillGap(line, last, x, 1);
+      last = x;
+    }
+  };
   forEachStripe(h, threads_, [&](std::size_t row_begin, std::size_t row_end) {
     // The in-range depths of rows y - 1, y and y + 1, in a ring of three rows.
     std::vector<float> ring(3 * w);
@@ -199,6 +224,7 @@ DepthPreprocessing::apply(const std::vector<float>& depth,
       if (y == 0 || y + 1 == h || w < 3) {
         for (std::size_t x = 0; x < w; ++x)
           border_pixel(x, y);
+        fill_row(y);
         continue;
       }
       if (y == row_begin || y - 1 == 0) {
@@ -212,28 +238,26 @@ DepthPreprocessing::apply(const std::vector<float>& depth,
       const float* down = ring.data() + ((y + 1) % 3) * w;
       keepInteriorRow(up, mid, down, out.data() + y * w, w, lo_factor, hi_factor);
       border_pixel(w - 1, y);
+      fill_row(y);
     }
   });
+}
 
+void
+DepthPreprocessing::applyColumns(std::uint32_t width,
+                                 std::uint32_t height,
+                                 std::vector<float>& out) const
+{
+  const std::size_t w = width;
+  const std::size_t h = height;
+  if (out.size() != w * h)
+    throw std::invalid_argument("[dynvo::DepthPreprocessing::applyColumns] the map holds " +
+                                std::to_string(out.size()) + " values, expected " +
+                                std::to_string(width) + "x" + std::to_string(height));
   const std::size_t max_gap = static_cast<std::size_t>(params_.max_hole_width);
   if (max_gap == 0)
     return;
   const float tau_fill = params_.hole_fill_tolerance;
-  // Row pass: each row is its own line.
-  forEachStripe(h, threads_, [&](std::size_t row_begin, std::size_t row_end) {
-    for (std::size_t y = row_begin; y < row_end; ++y) {
-      float* line = out.data() + y * w;
-      std::size_t last = w; // no valid pixel seen yet
-      for (std::size_t x = 0; x < w; ++x) {
-        if (std::isnan(line[x]))
-          continue;
-        if (last != w && x - last - 1 >= 1 && x - last - 1 <= max_gap &&
-            similar(line[last], line[x], tau_fill))
-          fillGap(line, last, x, 1);
-        last = x;
-      }
-    }
-  });
   // Column pass on the row-filled map: stripes own column ranges and walk the rows in order,
   // remembering the last valid row of every column, which keeps memory access row-major. Each
   // row first marks the columns that close a gap (branch-free, vectorised), then fills those.

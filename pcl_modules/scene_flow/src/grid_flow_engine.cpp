@@ -269,16 +269,20 @@ GridFlowEngine::prepare(Slot slot,
                                 cv::Size(params.window_size, params.window_size),
                                 params.max_pyramid_level, true);
   };
-  // The depth map first, in stripes on every thread; then the pyramid and the centres'
-  // depths, which are independent: with two threads, one each. (VGA, one thread: the
-  // preprocessing about 0.8 ms, the pyramid 0.3 ms, the centres' depths 0.2 ms.)
-  frame.preprocessing.apply(depth, width, height, frame.depth);
+  // The depth map's rows first, in stripes on every thread; then the pyramid beside the
+  // depth map's column pass and the centres' depths, which need the whole map: with two
+  // threads, one each (VGA, one thread: the rows 0.5 ms, the pyramid 0.28 ms, the columns
+  // 0.1 ms, the centres' depths 0.15 ms). The column pass, nested in a stripe, stays on
+  // its thread (forEachStripe()).
+  frame.preprocessing.applyRows(depth, width, height, frame.depth);
   const unsigned tasks = std::min(threads, 2u);
   forEachStripe(tasks, tasks, [&](std::size_t s, std::size_t) {
     if (s == 0)
       build_pyramid();
-    if (s + 1 == tasks)
+    if (s + 1 == tasks) {
+      frame.preprocessing.applyColumns(width, height, frame.depth);
       build_centre_depths();
+    }
   });
 }
 

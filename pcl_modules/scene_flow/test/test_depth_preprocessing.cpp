@@ -125,6 +125,26 @@ TEST_F(DepthPreprocessingTest, ColumnPassFillsHolesThatNoRowCanBridge)
       EXPECT_EQ(out(x, y), 1.0f) << x << "," << y;
 }
 
+TEST_F(DepthPreprocessingTest, RowsThenColumnsIsApply)
+{
+  // The scene flow runs the column pass beside its pyramid: applyRows() must leave exactly
+  // the column pass to applyColumns(), and the two in turn must be apply().
+  flat(10, 12, 1.0f);
+  for (std::uint32_t x = 0; x < 10; ++x)
+    at(x, 5) = NaN; // a whole row missing: only the column pass bridges it
+  at(3, 9) = NaN;   // a narrow row hole: the row pass fills it
+  std::vector<float> rows;
+  preprocessing_.applyRows(depth_, width_, height_, rows);
+  EXPECT_TRUE(std::isnan(rows[5 * 10 + 4]));
+  EXPECT_EQ(rows[9 * 10 + 3], 1.0f);
+  preprocessing_.applyColumns(width_, height_, rows);
+  EXPECT_EQ(rows[5 * 10 + 4], 1.0f);
+  run();
+  EXPECT_EQ(rows, out_);
+  EXPECT_THROW(preprocessing_.applyColumns(width_, height_ + 1, rows),
+               std::invalid_argument);
+}
+
 TEST_F(DepthPreprocessingTest, ResultDoesNotDependOnThreadCount)
 {
   flat(97, 61, 1.0f);

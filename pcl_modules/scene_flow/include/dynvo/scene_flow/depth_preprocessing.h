@@ -79,6 +79,20 @@ public:
              std::uint32_t height,
              std::vector<float>& out) const;
 
+  /** \brief apply() in two parts, for a caller with other work to run beside the second:
+   * applyRows() makes steps 1, 2 and the row pass of step 3 (each row's pass right after the
+   * row's flying pixels: it reads that row only), applyColumns() the column pass on the map
+   * applyRows() made. apply() is the two in turn. Arguments and exceptions as apply()'s;
+   * applyColumns() throws when out does not hold width * height values.
+   */
+  void applyRows(const std::vector<float>& depth,
+                 std::uint32_t width,
+                 std::uint32_t height,
+                 std::vector<float>& out) const;
+
+  /// The second part of apply(): see applyRows().
+  void applyColumns(std::uint32_t width, std::uint32_t height, std::vector<float>& out) const;
+
 private:
   Parameters params_;    ///< validated knobs
   unsigned threads_ = 1; ///< worker threads (>= 1)
