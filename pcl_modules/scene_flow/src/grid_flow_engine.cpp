@@ -566,10 +566,14 @@ GridFlowEngine::track(const Frame& reference,
     const float ratio = params.weight_reference_depth / std::max(z_a, f.z);
     f.weight = std::min(1.0f, ratio * ratio * ratio * ratio);
   };
-  // Cells are independent: stripes of cells, the same flow for any thread count.
-  forEachStripe(n, threads, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i)
-      finish_cell(i);
+  // Cells are independent: the same flow for any split. Stripe s takes every stripes-th row
+  // of cells from the s-th, as the tracks do: contiguous halves cost unlike (the image's
+  // lower half holds more cells with depth: 117 against 178 us on tum_fr1_xyz_200).
+  const std::size_t row_stripes = std::min<std::size_t>(threads, rows);
+  forEachStripe(row_stripes, row_stripes, [&](std::size_t s, std::size_t) {
+    for (std::size_t row = s; row < static_cast<std::size_t>(rows); row += row_stripes)
+      for (std::size_t i = row * cols; i < (row + 1) * cols; ++i)
+        finish_cell(i);
   });
 }
 
