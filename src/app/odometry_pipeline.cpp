@@ -354,7 +354,7 @@ struct OdometryPipeline::Impl {
     const auto inputs = [this, cloud, target_cells = previous_static_cells] {
       const auto start = Clock::now();
       backend.setInputSource(cloud, flow_estimation.getInputGrey(),
-                             flow_estimation.getInputDepth());
+                             *flow_estimation.getInputDepth());
       backend.setInputTarget(previous);
       if (target_cells.size() > 0) {
         backend.setTargetStaticCells(target_cells);

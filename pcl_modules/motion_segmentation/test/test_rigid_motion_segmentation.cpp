@@ -141,19 +141,20 @@ TEST(RigidMotionSegmentationContract, DepthImageGivesTheLabelsOfTheCloud)
   const auto synthetic = objectFlow();
   const auto cloud =
       dynvo::test::cloudFromFlow<pcl::PointXYZRGB>(*synthetic.flow, CELL);
-  std::vector<float> depth;
+  using Image = std::shared_ptr<const std::vector<float>>;
+  std::vector<float> z;
   for (const auto& point : *cloud)
-    depth.push_back(std::isfinite(point.z) ? point.z
-                                           : std::numeric_limits<float>::quiet_NaN());
+    z.push_back(std::isfinite(point.z) ? point.z : std::numeric_limits<float>::quiet_NaN());
+  const Image depth = std::make_shared<const std::vector<float>>(z);
   // Each run on a new object: same seed, same cell stage, only the pixels' source differs.
-  const auto run = [&](const std::vector<float>* image, bool before_cloud = false) {
+  const auto run = [&](const Image& image, bool before_cloud = false) {
     dynvo::RigidMotionSegmentation<pcl::PointXYZRGB> segmentation;
     segmentation.setSeed(7);
     if (image && before_cloud)
-      segmentation.setInputDepth(*image);
+      segmentation.setInputDepth(image);
     segmentation.setInputCloud(cloud);
     if (image && !before_cloud)
-      segmentation.setInputDepth(*image);
+      segmentation.setInputDepth(image);
     segmentation.setInputFlow(synthetic.flow);
     std::vector<pcl::PointIndices> segments;
     segmentation.segment(segments);
@@ -162,16 +163,17 @@ TEST(RigidMotionSegmentationContract, DepthImageGivesTheLabelsOfTheCloud)
   const auto from_cloud = run(nullptr);
   // Not vacuous: background and object, so boundary cells compare per-pixel depths.
   ASSERT_GE(from_cloud.second, 2u);
-  EXPECT_EQ(run(&depth), from_cloud);
+  EXPECT_EQ(run(depth), from_cloud);
   // The image is what is read: without depth no pixel gets a label.
-  const std::vector<float> none(depth.size(), std::numeric_limits<float>::quiet_NaN());
-  const auto from_none = run(&none);
+  const Image none = std::make_shared<const std::vector<float>>(
+      z.size(), std::numeric_limits<float>::quiet_NaN());
+  const auto from_none = run(none);
   EXPECT_EQ(std::count(from_none.first.begin(), from_none.first.end(), 0),
-            static_cast<long>(none.size()));
+            static_cast<long>(none->size()));
   // An image of another size is ignored, and setInputCloud() drops the image set before it.
-  const std::vector<float> short_by_one(depth.begin(), depth.end() - 1);
-  EXPECT_EQ(run(&short_by_one), from_cloud);
-  EXPECT_EQ(run(&none, true), from_cloud);
+  EXPECT_EQ(run(std::make_shared<const std::vector<float>>(z.begin(), z.end() - 1)),
+            from_cloud);
+  EXPECT_EQ(run(none, true), from_cloud);
 }
 
 TEST(RigidMotionSegmentationContract, BadInputsClearOutputs)

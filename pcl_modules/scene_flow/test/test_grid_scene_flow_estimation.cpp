@@ -402,15 +402,21 @@ TYPED_TEST(GridSceneFlowTest, InputDepthAndGreyAreThoseOfTheInputCloud)
   const auto f2 = this->view(scene, pose(0, 0.8, 0, 0.02, 0.005, 0));
   // z and grey level of every point, NaN where it has no z; the views differ, so a mix-up
   // shows.
-  const auto matches = [](const auto& estimation, const auto& cloud) {
-    const std::vector<float>& depth = estimation.getInputDepth();
-    const std::vector<std::uint8_t>& grey = estimation.getInputGrey();
-    if (depth.size() != cloud.size() || grey.size() != cloud.size())
+  const auto sameZ = [](const std::vector<float>& depth, const auto& cloud) {
+    if (depth.size() != cloud.size())
       return false;
     for (std::size_t i = 0; i < depth.size(); ++i)
-      if (!(depth[i] == cloud[i].z ||
-            (std::isnan(depth[i]) && !std::isfinite(cloud[i].z))) ||
-          grey[i] != dynvo::luma(cloud[i].r, cloud[i].g, cloud[i].b))
+      if (!(depth[i] == cloud[i].z || (std::isnan(depth[i]) && !std::isfinite(cloud[i].z))))
+        return false;
+    return true;
+  };
+  const auto matches = [&](const auto& estimation, const auto& cloud) {
+    const std::vector<std::uint8_t>& grey = estimation.getInputGrey();
+    if (!estimation.getInputDepth() || !sameZ(*estimation.getInputDepth(), cloud) ||
+        grey.size() != cloud.size())
+      return false;
+    for (std::size_t i = 0; i < grey.size(); ++i)
+      if (grey[i] != dynvo::luma(cloud[i].r, cloud[i].g, cloud[i].b))
         return false;
     return true;
   };
@@ -419,14 +425,25 @@ TYPED_TEST(GridSceneFlowTest, InputDepthAndGreyAreThoseOfTheInputCloud)
   this->run(f0.cloud, f1.cloud);
   EXPECT_TRUE(matches(estimation, *f1.cloud));
   EXPECT_FALSE(matches(estimation, *f0.cloud));
+  // A later stage keeps the image it was given (shared, not copied): the next frames'
+  // compute() write other images.
+  const auto kept = estimation.getInputDepth();
   estimation.shiftCurrentToPrevious();
-  EXPECT_TRUE(estimation.getInputDepth().empty());
+  EXPECT_FALSE(estimation.getInputDepth());
   EXPECT_TRUE(estimation.getInputGrey().empty());
   estimation.setInputCloud(f2.cloud);
-  EXPECT_TRUE(estimation.getInputDepth().empty()); // not read before compute()
+  EXPECT_FALSE(estimation.getInputDepth()); // not read before compute()
   EXPECT_TRUE(estimation.getInputGrey().empty());
   estimation.compute(this->flow_);
   EXPECT_TRUE(matches(estimation, *f2.cloud));
+  const auto* f2_image = estimation.getInputDepth().get();
+  estimation.shiftCurrentToPrevious();
+  estimation.setInputCloud(f0.cloud);
+  estimation.compute(this->flow_);
+  EXPECT_TRUE(matches(estimation, *f0.cloud));
+  EXPECT_EQ(estimation.getInputDepth().get(), f2_image); // let go of: written again
+  ASSERT_TRUE(kept);
+  EXPECT_TRUE(sameZ(*kept, *f1.cloud));
 }
 
 /// The camera of a steady sweep at t seconds: 60 deg/s about y, 0.3 m/s sideways and

@@ -22,6 +22,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -87,9 +88,12 @@ public:
    * such as GridSceneFlowEstimation::getInputDepth() after its compute() on the same cloud.
    * Optional: the pixel labels read it instead of the cloud's points (the same labels; the
    * points are 8 times larger than their z). Call it after setInputCloud(); ignored unless it
-   * holds one value per point.
+   * holds one value per point. Kept, not copied: its holder must not change it meanwhile.
    */
-  void setInputDepth(const std::vector<float>& depth) { input_depth_ = depth; }
+  void setInputDepth(const std::shared_ptr<const std::vector<float>>& depth)
+  {
+    input_depth_ = depth;
+  }
 
   /// Grid scene flow from frame k-1 to frame k (organized, (width / w_grid) x (height / w_grid));
   /// the cell size w_grid is inferred from it (FlowGrid::fromFlow()).
@@ -307,7 +311,7 @@ private:
   Motions motions_;                          ///< T_curr_prev of each output segment
   PixelLabelRefinement refinement_;          ///< cell labels to pixel labels
   std::vector<std::uint8_t> pixel_labels_;   ///< label per pixel of the last segment()
-  std::vector<float> input_depth_;           ///< setInputDepth(); empty: the cloud's z
+  std::shared_ptr<const std::vector<float>> input_depth_; ///< setInputDepth(); null: the cloud's z
   /// s_axial, s_lateral: the sensor model's gains on its axial and lateral sigma, fitted
   /// over the frames
   std::array<float, 2> noise_gains_{1.0f, 1.0f};

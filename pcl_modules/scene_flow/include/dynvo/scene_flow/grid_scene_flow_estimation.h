@@ -12,7 +12,9 @@
 #include <pcl/pcl_base.h>
 #include <pcl/point_cloud.h>
 
+#include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -92,10 +94,11 @@ public:
   const PointCloudConstPtr& getPreviousCloud() const { return previous_; }
 
   /** \brief The input cloud's z as compute() read it, row-major (metres, NaN where not
-   * finite), for the stages after this one (RigidMotionSegmentation::setInputDepth()).
-   * Empty until compute() has read the input cloud set last.
+   * finite), for the stages after this one (RigidMotionSegmentation::setInputDepth()):
+   * shared, not copied. Null until compute() has read the input cloud set last. A holder
+   * keeps its image unchanged: compute() writes each frame's into one nobody else holds.
    */
-  const std::vector<float>& getInputDepth() const { return depth_; }
+  std::shared_ptr<const std::vector<float>> getInputDepth() const { return depth_; }
 
   /** \brief The input cloud's grey levels (luma()) as compute() read them, row-major, for the
    * stages after this one (StaticMaskRegistration::setInputSource()). Empty until compute()
@@ -225,7 +228,10 @@ private:
   bool current_ready_ = false;  ///< engine current slot matches input_ and params_
   bool previous_ready_ = false; ///< engine previous slot matches previous_ and params_
   std::vector<std::uint8_t> grey_; ///< the input cloud's grey levels (getInputGrey())
-  std::vector<float> depth_;       ///< the input cloud's z (getInputDepth())
+  std::shared_ptr<std::vector<float>> depth_; ///< the input cloud's z (getInputDepth())
+  /// the images depth_ is one of: two, so that compute() finds one the last frame's holder
+  /// (the segmentation's pixel stage) has let go of
+  std::array<std::shared_ptr<std::vector<float>>, 2> depth_buffers_;
   std::vector<std::uint8_t> selected_; ///< cells computeToKeyframe() tracks
   Eigen::Matrix4f predicted_motion_ = Eigen::Matrix4f::Identity(); ///< H_pred
 };

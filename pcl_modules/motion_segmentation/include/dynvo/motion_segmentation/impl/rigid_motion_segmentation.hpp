@@ -24,7 +24,7 @@ void
 RigidMotionSegmentation<PointT>::setInputCloud(const PointCloudConstPtr& cloud)
 {
   Base::setInputCloud(cloud);
-  input_depth_.clear();
+  input_depth_.reset();
 }
 
 template <typename PointT>
@@ -144,9 +144,9 @@ RigidMotionSegmentation<PointT>::computeImplPixelLabels()
   const std::uint32_t* rgba = nullptr;
   if constexpr (pcl::traits::has_color<PointT>::value)
     rgba = &(*input_)[0].rgba;
-  const bool image = input_depth_.size() == input_->size();
+  const bool image = input_depth_ && input_depth_->size() == input_->size();
   refinement_.refine(output_grid_, fallback,
-                     image ? input_depth_.data() : &(*input_)[0].z, image ? 1 : stride,
+                     image ? input_depth_->data() : &(*input_)[0].z, image ? 1 : stride,
                      rgba, stride, pixel_labels_);
 }
 

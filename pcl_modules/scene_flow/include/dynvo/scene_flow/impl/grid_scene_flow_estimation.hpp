@@ -10,6 +10,7 @@
 
 #include <pcl/console/print.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -25,7 +26,7 @@ GridSceneFlowEstimation<PointT>::setInputCloud(const PointCloudConstPtr& cloud)
   current_ready_ = false;
   input_stamps_ = {};
   grey_.clear();
-  depth_.clear();
+  depth_.reset();
 }
 
 template <typename PointT>
@@ -49,7 +50,7 @@ GridSceneFlowEstimation<PointT>::shiftCurrentToPrevious()
   current_ready_ = false;
   input_stamps_ = {};
   grey_.clear();
-  depth_.clear();
+  depth_.reset();
 }
 
 template <typename PointT>
@@ -173,9 +174,20 @@ GridSceneFlowEstimation<PointT>::compute(FlowCloud& flow)
   } guard{*this};
   if (!validateInputs())
     return;
-  if (!current_ready_)
+  if (!current_ready_) {
+    // A buffer no one else holds (use count 1: this object's), else a new one in place of
+    // the first (its holder keeps it).
+    depth_.reset();
+    auto free = std::find_if(depth_buffers_.begin(), depth_buffers_.end(),
+                             [](const auto& buffer) { return buffer.use_count() <= 1; });
+    if (free == depth_buffers_.end())
+      free = depth_buffers_.begin();
+    if (free->use_count() != 1)
+      *free = std::make_shared<std::vector<float>>();
+    depth_ = *free;
     prepareFrame(*input_, detail::GridFlowEngine::Slot::current, input_stamps_, grey_,
-                 depth_);
+                 *depth_);
+  }
   current_ready_ = true;
   if (!previous_ready_) { // the first pair, or a previous cloud set apart
     std::vector<std::uint8_t> grey;
