@@ -29,6 +29,20 @@ fillGap(float* line, std::size_t l, std::size_t r, std::size_t step)
     line[k * step] = zl + (zr - zl) * static_cast<float>(k - l) / span;
 }
 
+/// Throws std::invalid_argument unless map holds width * height values.
+void
+requireSize(const std::vector<float>& map,
+            std::uint32_t width,
+            std::uint32_t height,
+            const char* where)
+{
+  if (map.size() != static_cast<std::size_t>(width) * height)
+    throw std::invalid_argument(std::string("[dynvo::DepthPreprocessing::") + where +
+                                "] the map holds " + std::to_string(map.size()) +
+                                " values, expected " + std::to_string(width) + "x" +
+                                std::to_string(height));
+}
+
 bool
 similar(float zl, float zr, float tolerance)
 {
@@ -165,12 +179,9 @@ DepthPreprocessing::applyRows(const std::vector<float>& depth,
 {
   const std::size_t w = width;
   const std::size_t h = height;
-  if (depth.size() != w * h)
-    throw std::invalid_argument("[dynvo::DepthPreprocessing::apply] depth holds " +
-                                std::to_string(depth.size()) + " values, expected " +
-                                std::to_string(width) + "x" + std::to_string(height));
+  requireSize(depth, width, height, "applyRows");
   if (&depth == &out)
-    throw std::invalid_argument("[dynvo::DepthPreprocessing::apply] out aliases depth");
+    throw std::invalid_argument("[dynvo::DepthPreprocessing::applyRows] out aliases depth");
   out.resize(w * h);
 
   // Steps 1 and 2 read only the input, so rows are independent. A depth outside [z_min, z_max]
@@ -250,10 +261,7 @@ DepthPreprocessing::applyColumns(std::uint32_t width,
 {
   const std::size_t w = width;
   const std::size_t h = height;
-  if (out.size() != w * h)
-    throw std::invalid_argument("[dynvo::DepthPreprocessing::applyColumns] the map holds " +
-                                std::to_string(out.size()) + " values, expected " +
-                                std::to_string(width) + "x" + std::to_string(height));
+  requireSize(out, width, height, "applyColumns");
   const std::size_t max_gap = static_cast<std::size_t>(params_.max_hole_width);
   if (max_gap == 0)
     return;

@@ -178,13 +178,13 @@ GridSceneFlowEstimation<PointT>::compute(FlowCloud& flow)
     // A buffer no one else holds (use count 1: this object's), else a new one in place of
     // the first (its holder keeps it).
     depth_.reset();
-    auto free = std::find_if(depth_buffers_.begin(), depth_buffers_.end(),
-                             [](const auto& buffer) { return buffer.use_count() <= 1; });
-    if (free == depth_buffers_.end())
-      free = depth_buffers_.begin();
-    if (free->use_count() != 1)
-      *free = std::make_shared<std::vector<float>>();
-    depth_ = *free;
+    auto unheld = std::find_if(depth_buffers_.begin(), depth_buffers_.end(),
+                               [](const auto& buffer) { return buffer.use_count() <= 1; });
+    if (unheld == depth_buffers_.end())
+      unheld = depth_buffers_.begin();
+    if (unheld->use_count() != 1)
+      *unheld = std::make_shared<std::vector<float>>();
+    depth_ = *unheld;
     prepareFrame(*input_, detail::GridFlowEngine::Slot::current, input_stamps_, grey_,
                  *depth_);
   }
