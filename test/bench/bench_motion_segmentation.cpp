@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Per-frame cost of the rigid motion segmentation stages at VGA (1200 cells, h_max 20).
 #include <dynvo/io/frame.h>
+#include <dynvo/motion_segmentation/patch_match.h>
 #include <dynvo/motion_segmentation/pixel_label_refinement.h>
 #include <dynvo/motion_segmentation/rigid_motion_segmentation.h>
 #include <dynvo/scene_flow/grid_scene_flow_estimation.h>
@@ -188,5 +189,29 @@ BENCHMARK(BM_PixelLabelRefinement)
     ->Arg(1)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+
+/// §4.1 alone: the ambiguity test of one far cell (r_amb 3 px: 49 positions around the
+/// background's, 9 around the track) between consecutive noisy frames, over every cell of a
+/// frame in turn. Its cost per frame is this times the far cells of the object segments.
+void
+BM_TrackIsAmbiguous(benchmark::State& state)
+{
+  const std::vector<FlowFrame>& frames = sequence(true);
+  const pcl::PointCloud<Point>& previous = *frames[0].cloud;
+  const pcl::PointCloud<Point>& current = *frames[1].cloud;
+  const dynvo::FramePairColours colours{&previous[0].rgba, &current[0].rgba,
+                                        sizeof(Point) / sizeof(float),
+                                        static_cast<int>(current.width),
+                                        static_cast<int>(current.height)};
+  const pcl::PointCloud<dynvo::PointFlow>& flow = *frames[1].flow;
+  std::size_t k = 0;
+  for (auto _ : state) {
+    const dynvo::PointFlow& cell = flow[k++ % flow.size()];
+    const Eigen::Vector2f centre(cell.u, cell.v);
+    benchmark::DoNotOptimize(dynvo::trackIsAmbiguous(
+        colours, centre, centre, centre + Eigen::Vector2f(12.0f, 0.0f), 3));
+  }
+}
+BENCHMARK(BM_TrackIsAmbiguous)->Unit(benchmark::kMicrosecond);
 
 } // namespace

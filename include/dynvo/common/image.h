@@ -16,6 +16,15 @@ luma(std::uint8_t r, std::uint8_t g, std::uint8_t b)
   return static_cast<std::uint8_t>((4899u * r + 9617u * g + 1868u * b + 8192u) >> 14);
 }
 
+/// luma() of a PCL packed rgba word (b in the low byte, then g, r).
+inline std::uint8_t
+lumaOfPacked(std::uint32_t rgba)
+{
+  return luma(static_cast<std::uint8_t>(rgba >> 16 & 0xffu),
+              static_cast<std::uint8_t>(rgba >> 8 & 0xffu),
+              static_cast<std::uint8_t>(rgba & 0xffu));
+}
+
 /// 8-bit colour image, row-major, 3 bytes per pixel in R, G, B order.
 struct ColorImage {
   std::uint32_t width = 0;        ///< columns (px)

@@ -20,15 +20,6 @@ hasDepth(float z)
   return std::isfinite(z) && z > 0.0f;
 }
 
-/// Grey level (luma) of a PCL packed rgba word (b in the low byte, then g, r).
-inline float
-greyOf(std::uint32_t rgba)
-{
-  return luma(static_cast<std::uint8_t>(rgba >> 16 & 0xffu),
-              static_cast<std::uint8_t>(rgba >> 8 & 0xffu),
-              static_cast<std::uint8_t>(rgba & 0xffu));
-}
-
 } // namespace
 
 void
@@ -72,7 +63,7 @@ PixelLabelRefinement::computeCellDepths(const FlowGrid& cells,
   for (std::size_t i = 0; i < cells.size(); ++i) {
     const std::size_t centre = cells.centreIndex(i);
     if (rgba)
-      cell_grey_[i] = greyOf(rgba[centre * rgba_stride]);
+      cell_grey_[i] = lumaOfPacked(rgba[centre * rgba_stride]);
     const float z = depth[centre * depth_stride];
     if (hasDepth(z)) {
       cell_depth_[i] = z;
@@ -277,7 +268,7 @@ PixelLabelRefinement::refine(const FlowGrid& cells,
           const float z = depth[p * depth_stride];
           if (!hasDepth(z))
             continue;
-          const float grey = rgba ? greyOf(rgba[p * rgba_stride]) : 0.0f;
+          const float grey = rgba ? lumaOfPacked(rgba[p * rgba_stride]) : 0.0f;
           const float inv_z2 = inv_tol2 / (z * z);
           const float fu = static_cast<float>(u), fv = static_cast<float>(v);
           float best = std::numeric_limits<float>::infinity();

@@ -12,7 +12,7 @@ RigidMotionSegmentationParameters::table()
 {
   using P = RigidMotionSegmentationParameters;
   using R = FieldRange;
-  static_assert(AGGREGATE_FIELD_COUNT<P> == 32, "every field of P needs a row below");
+  static_assert(AGGREGATE_FIELD_COUNT<P> == 33, "every field of P needs a row below");
   using Fields = std::vector<ParameterTable<P>::Field>;
   static const ParameterTable<P> table{Fields{
       makeField("max_hypotheses", &P::max_hypotheses, R::closed(1, 254), "h_max"),
@@ -62,6 +62,8 @@ RigidMotionSegmentationParameters::table()
                 "n_birth, frames, 1 = off"),
       makeField("object_birth_ratio", &P::object_birth_ratio, R::atLeast(0),
                 "k_birth, 0 = off"),
+      makeField("ambiguity_search_radius", &P::ambiguity_search_radius, R::atLeast(0),
+                "r_amb, px, 0 = off"),
       makeField("seed", &P::seed, R::closed(0, 4294967295.0), "sampling seed")}};
   return table;
 }

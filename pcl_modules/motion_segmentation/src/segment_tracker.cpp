@@ -28,6 +28,14 @@ median(std::vector<float>& values)
   return *middle;
 }
 
+/// The segment (1..g) with label 1 in `ids`, 0 when none has.
+int
+labelOneSegment(const std::vector<int>& ids)
+{
+  const auto found = std::find(ids.begin() + 1, ids.end(), LABEL_STATIC);
+  return found == ids.end() ? 0 : static_cast<int>(found - ids.begin());
+}
+
 } // namespace
 
 double
@@ -337,10 +345,10 @@ SegmentTracker::mergeNoiseSplits(const GridFlowData& grid,
                                  std::vector<int>& ids) const
 {
   const int g = spatial.segmentCount();
-  const auto background = std::find(ids.begin() + 1, ids.end(), LABEL_STATIC);
-  if (grid.information.empty() || background == ids.end())
+  const int background = labelOneSegment(ids);
+  if (grid.information.empty() || background == 0)
     return;
-  const Eigen::Matrix4d& H = spatial.motions[background - ids.begin() - 1];
+  const Eigen::Matrix4d& H = spatial.motions[background - 1];
   const Eigen::Matrix3f R = H.topLeftCorner<3, 3>().cast<float>();
   const Eigen::Vector3f t = H.topRightCorner<3, 1>().cast<float>();
   std::vector<std::vector<float>> errors(g + 1);
@@ -352,6 +360,53 @@ SegmentTracker::mergeNoiseSplits(const GridFlowData& grid,
   for (int c = 1; c <= g; ++c)
     if (!errors[c].empty() && median(errors[c]) <= 0.5f * params.inlier_chi2)
       ids[c] = LABEL_STATIC;
+}
+
+void
+SegmentTracker::settleAmbiguousTracks(const GridFlowData& grid,
+                                      const SpatialSegmentationResult& spatial,
+                                      const std::vector<int>& ids,
+                                      int background,
+                                      const CameraIntrinsics& intrinsics,
+                                      const FramePairColours& colours,
+                                      const RigidMotionSegmentationParameters& params)
+{
+  const int radius = params.ambiguity_search_radius;
+  if (radius <= 0 || background == 0 || colours.empty() ||
+      colours.width != static_cast<int>(grid.geometry.image_width) ||
+      colours.height != static_cast<int>(grid.geometry.image_height))
+    return;
+  const Eigen::Matrix4f H_inverse =
+      rigidInverse(spatial.motions[background - 1]).cast<float>();
+  const int g = spatial.segmentCount();
+  std::vector<int> cells(g + 1, 0), far(g + 1, 0), ambiguous(g + 1, 0);
+  std::vector<std::uint8_t> settled(grid.size(), 0);
+  const auto far_limit = static_cast<float>(2 * radius);
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    const int c = spatial.labels[i];
+    if (c == 0 || ids[c] <= LABEL_STATIC || !grid.valid_2d[i] || !grid.valid_3d[i])
+      continue;
+    const Eigen::Vector3f a_background =
+        (H_inverse * grid.b[i].homogeneous()).head<3>();
+    if (!(a_background.z() > 0.0f))
+      continue;
+    ++cells[c];
+    const Eigen::Vector2f& p = grid.previous_pixel[i];
+    const Eigen::Vector2f q =
+        p + intrinsics.project(a_background) - intrinsics.project(grid.a[i]);
+    if ((q - p).norm() <= far_limit)
+      continue;
+    ++far[c];
+    if (trackIsAmbiguous(colours, grid.cellCentre(i), p, q, radius)) {
+      ++ambiguous[c];
+      settled[i] = 1;
+    }
+  }
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    const int c = spatial.labels[i];
+    if (settled[i] && 2 * far[c] >= cells[c] && 2 * ambiguous[c] >= far[c])
+      tracked_[i] = LABEL_STATIC;
+  }
 }
 
 void
@@ -588,7 +643,8 @@ SegmentTracker::update(const GridFlowData& grid,
                        const SpatialSegmentationResult& spatial,
                        const Eigen::Matrix4d& T_pred,
                        const CameraIntrinsics& intrinsics,
-                       const RigidMotionSegmentationParameters& params)
+                       const RigidMotionSegmentationParameters& params,
+                       const FramePairColours& colours)
 {
   if (model_.cols() != grid.cols() || model_.rows() != grid.rows() ||
       model_.labels() != params.max_labels) {
@@ -617,10 +673,12 @@ SegmentTracker::update(const GridFlowData& grid,
   // pipeline's identity would hand label 1 to whatever moves least in the image).
   if (grid.information.empty() || hasHistory())
     guardBackground(grid, spatial, T_pred, params, ids);
+  const int background = labelOneSegment(ids);
   mergeNoiseSplits(grid, spatial, params, ids);
   tracked_.resize(grid.size());
   for (std::size_t i = 0; i < grid.size(); ++i)
     tracked_[i] = static_cast<std::uint8_t>(ids[spatial.labels[i]]);
+  settleAmbiguousTracks(grid, spatial, ids, background, intrinsics, colours, params);
   keepObjectsApart(grid, spatial, ids, params);
 
   // §6 then §5: carry the models into the current grid, fold in Ghat, read out L.

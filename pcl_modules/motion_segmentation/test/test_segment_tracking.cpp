@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <limits>
 #include <numeric>
 #include <random>
@@ -766,6 +767,39 @@ TEST(BackgroundGuard, MotionsAreComparedWithThePredictionOverTheWholeScene)
   EXPECT_GT(std::count(truth_small.begin(), truth_small.end(), 2), 0);
 }
 
+/** The two-frame segmentation given by hand: segment c holds the cells with 3D flow whose
+ * region id (makeSyntheticFlow's truth) is c, ids above `count` joining segment 1, each with
+ * the motion fitted on its cells; no motions when a fit fails.
+ */
+dynvo::SpatialSegmentationResult
+segmentsOfRegions(const dynvo::GridFlowData& grid,
+                  const std::vector<int>& region,
+                  int count,
+                  const dynvo::RigidMotionSegmentationParameters& params)
+{
+  dynvo::SpatialSegmentationResult spatial;
+  spatial.labels.assign(grid.size(), 0);
+  spatial.sizes.assign(count, 0);
+  std::vector<dynvo::RigidFitAccumulator> fits(count);
+  for (std::size_t i = 0; i < grid.size(); ++i)
+    if (grid.valid_3d[i]) {
+      const int c = region[i] >= 1 && region[i] <= count ? region[i] : 1;
+      spatial.labels[i] = static_cast<std::uint8_t>(c);
+      ++spatial.sizes[c - 1];
+      fits[c - 1].add(grid.a[i].cast<double>(), grid.b[i].cast<double>());
+    }
+  for (const dynvo::RigidFitAccumulator& fit : fits) {
+    Eigen::Matrix4d H;
+    if (fit.solve(H) != dynvo::RigidFitStatus::ok) {
+      spatial.motions.clear();
+      break;
+    }
+    spatial.motions.push_back(H);
+  }
+  spatial.inlier_threshold = params.inlier_chi2;
+  return spatial;
+}
+
 TEST(ObjectSeparation, ObjectMergedWholeIntoTheBackgroundKeepsItsId)
 {
   // A box (8 x 14 cells at 1.2 m) before a static background moves 4 cm per frame, then 3
@@ -797,21 +831,9 @@ TEST(ObjectSeparation, ObjectMergedWholeIntoTheBackgroundKeepsItsId)
     grid.assign(*synthetic.flow, geometry);
     grid.setSensorNoise(params.noise, intrinsics.fx, 1.0f, 1.0f);
     // Segment 1 the background, 2 the box, each with the motion fitted on its cells.
-    dynvo::SpatialSegmentationResult spatial;
-    spatial.labels.assign(grid.size(), 0);
-    spatial.sizes.assign(2, 0);
-    std::array<dynvo::RigidFitAccumulator, 2> fits;
-    for (std::size_t i = 0; i < grid.size(); ++i)
-      if (grid.valid_3d[i]) {
-        const int c = truth[i] == 2 ? 2 : 1;
-        spatial.labels[i] = static_cast<std::uint8_t>(c);
-        ++spatial.sizes[c - 1];
-        fits[c - 1].add(grid.a[i].cast<double>(), grid.b[i].cast<double>());
-      }
-    spatial.motions.resize(2);
-    for (int c = 0; c < 2; ++c)
-      ASSERT_EQ(fits[c].solve(spatial.motions[c]), dynvo::RigidFitStatus::ok);
-    spatial.inlier_threshold = params.inlier_chi2;
+    const dynvo::SpatialSegmentationResult spatial =
+        segmentsOfRegions(grid, truth, 2, params);
+    ASSERT_EQ(spatial.motions.size(), 2u);
     tracker.update(grid, spatial, Eigen::Matrix4d::Identity(), intrinsics, params);
   }
   // The premise: the box's cells fit the background's motion within the noise-split merge's
@@ -831,6 +853,81 @@ TEST(ObjectSeparation, ObjectMergedWholeIntoTheBackgroundKeepsItsId)
   ASSERT_LE(box_errors[box_errors.size() / 2], 0.5f * params.inlier_chi2);
   // Every box cell keeps the box's id (before: all of them became background).
   EXPECT_EQ(kept, box_cells);
+}
+
+TEST(AmbiguousTracks, TracksOnRepeatedTextureTakeTheBackground)
+{
+  // A still camera over a still scene; in one block of 6 x 6 cells (A) the texture repeats
+  // every 12 px along x (a row of keys) and every track settled one copy over, 12 px off;
+  // another block (B), of unique texture, truly moves 12 px. The two-frame segmentation is
+  // given by hand: background, A, B, each with the motion fitted on its cells (A's and B's
+  // alike). The background's motion puts A's cells where their patches match exactly, as
+  // well as their own tracks do: A's cells take label 1. B's do not match there: B stays an
+  // object. With the test off (radius 0) A is an object too.
+  constexpr int CELL = 16, COLS = 20, ROWS = 15, W = COLS * CELL, H = ROWS * CELL;
+  constexpr int PERIOD = 12;
+  const dynvo::CameraIntrinsics intrinsics = dynvo::test::intrinsicsFor(W);
+  const double depth = 1.2;
+  // 12 px at 1.2 m; the blocks' depth grows by 1 cm per column, so the tracks lie 11.5-12 px
+  // off, within the 1 px the own track is searched over.
+  const Eigen::Matrix4d shift = dynvo::test::makeMotion(
+      {0, 0, 1}, 0.0, {-PERIOD * depth / intrinsics.fx, 0.0, 0.0});
+  const auto synthetic = dynvo::test::makeSyntheticFlow(
+      COLS, ROWS, CELL, intrinsics, Eigen::Matrix4d::Identity(),
+      {{3, 4, 9, 10, depth, shift, 2}, {12, 4, 18, 10, depth, shift, 3}});
+  // Frame k-1: unique texture, repeated around A; frame k: the same, but B's pixels moved.
+  std::mt19937 random(3);
+  std::uniform_int_distribution<int> level(0, 255);
+  const auto packed = [](int g) {
+    const auto v = static_cast<std::uint32_t>(std::clamp(g, 0, 255));
+    return v << 16 | v << 8 | v;
+  };
+  std::vector<std::uint32_t> previous(std::size_t{W} * H), current(previous.size());
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const bool keys = x >= 40 && x < 150 && y >= 56 && y < 168;
+      previous[std::size_t(y) * W + x] = packed(
+          keys ? 128 + static_cast<int>(60.0 * std::sin(2.0 * M_PI * x / PERIOD)) +
+                     y * 37 % 29
+               : level(random));
+    }
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const bool moved = x >= 186 && x < 280 && y >= 60 && y < 164;
+      current[std::size_t(y) * W + x] =
+          previous[std::size_t(y) * W + x + (moved ? PERIOD : 0)];
+    }
+  const dynvo::FramePairColours colours{previous.data(), current.data(), 1, W, H};
+
+  dynvo::FlowGrid geometry;
+  ASSERT_TRUE(dynvo::FlowGrid::fromFlow(*synthetic.flow, W, H, geometry));
+  dynvo::GridFlowData grid;
+  grid.assign(*synthetic.flow, geometry);
+  dynvo::RigidMotionSegmentationParameters params;
+  grid.setSensorNoise(params.noise, intrinsics.fx, 1.0f, 1.0f);
+  const dynvo::SpatialSegmentationResult spatial =
+      segmentsOfRegions(grid, synthetic.truth, 3, params);
+  ASSERT_EQ(spatial.motions.size(), 3u);
+
+  const auto labelsOf = [&](int radius, int block) {
+    params.ambiguity_search_radius = radius;
+    dynvo::SegmentTracker tracker;
+    tracker.update(grid, spatial, Eigen::Matrix4d::Identity(), intrinsics, params,
+                   colours);
+    std::vector<int> labels;
+    for (std::size_t i = 0; i < grid.size(); ++i)
+      if (synthetic.truth[i] == block)
+        labels.push_back(tracker.trackedLabels()[i]);
+    return labels;
+  };
+  const auto count = [](const std::vector<int>& labels, int label) {
+    return std::count(labels.begin(), labels.end(), label);
+  };
+  const std::vector<int> a = labelsOf(3, 2), b = labelsOf(3, 3), a_off = labelsOf(0, 2);
+  ASSERT_EQ(a.size(), 36u);
+  EXPECT_EQ(count(a, 1), 36);
+  EXPECT_EQ(count(b, 1), 0);
+  EXPECT_EQ(count(a_off, 1), 0);
 }
 
 } // namespace

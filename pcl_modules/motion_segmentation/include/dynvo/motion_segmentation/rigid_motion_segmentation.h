@@ -58,6 +58,9 @@ namespace dynvo {
  *   segmentation.segment(segments); // segments[0]: static background
  * }
  * \endcode
+ * Each segment() (or segmentCells()) takes its frame as frame k and keeps it as the next
+ * call's frame k-1, whose colours the ambiguity test reads (docs/algorithm.md §4.1): frames
+ * are given in order, each once.
  * Not thread-safe; separate instances may run concurrently. Explicitly instantiated for
  * pcl::PointXYZRGB and pcl::PointXYZRGBA (other types: include the impl .hpp).
  */
@@ -255,6 +258,7 @@ public:
   DYNVO_PARAMETER_ACCESSORS(ObjectSeparationHold, object_separation_hold)
   DYNVO_PARAMETER_ACCESSORS(ObjectBirthFrames, object_birth_frames)
   DYNVO_PARAMETER_ACCESSORS(ObjectBirthRatio, object_birth_ratio)
+  DYNVO_PARAMETER_ACCESSORS(AmbiguitySearchRadius, ambiguity_search_radius)
   DYNVO_PARAMETER_ACCESSORS(Seed, seed)
 
 protected:
@@ -312,6 +316,8 @@ private:
   PixelLabelRefinement refinement_;          ///< cell labels to pixel labels
   std::vector<std::uint8_t> pixel_labels_;   ///< label per pixel of the last segment()
   std::shared_ptr<const std::vector<float>> input_depth_; ///< setInputDepth(); null: the cloud's z
+  PointCloudConstPtr previous_input_; ///< frame k-1: the last segmentCells()'s but one
+  PointCloudConstPtr last_input_;     ///< the input of the last segmentCells()
   /// s_axial, s_lateral: the sensor model's gains on its axial and lateral sigma, fitted
   /// over the frames
   std::array<float, 2> noise_gains_{1.0f, 1.0f};

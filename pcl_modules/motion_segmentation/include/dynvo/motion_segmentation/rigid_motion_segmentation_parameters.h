@@ -112,6 +112,12 @@ struct DYNVO_EXPORTS RigidMotionSegmentationParameters {
   /// synthetic objects entering or starting again pass it (enter_stop_leave loses moving_iou
   /// from 8 on).
   float object_birth_ratio = 5.0f;
+  /// r_amb (px, >= 0, 0 = off) [D]: the ambiguity test (docs/algorithm.md §4.1) searches
+  /// frame k-1 within r_amb px of where the background's motion puts a cell, and calls the
+  /// cell far from it beyond 2 r_amb. 3: on TUM fr1/xyz the background's positions of
+  /// aliased keyboard cells lie 20-24 px from their tracks, and their best matches within
+  /// 1-3 px of those positions.
+  int ambiguity_search_radius = 3;
   /// seed: hypothesis sampling RNG, re-seeded on every segment()
   std::uint32_t seed = 0;
 

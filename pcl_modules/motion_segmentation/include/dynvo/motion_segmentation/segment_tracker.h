@@ -6,6 +6,7 @@
 #include <dynvo/common/export.h>
 #include <dynvo/motion_segmentation/dual_label_model.h>
 #include <dynvo/motion_segmentation/grid_flow_data.h>
+#include <dynvo/motion_segmentation/patch_match.h>
 #include <dynvo/motion_segmentation/rigid_motion_segmentation_parameters.h>
 #include <dynvo/motion_segmentation/spatial_segmentation.h>
 
@@ -54,12 +55,14 @@ public:
    * \param[in] T_pred H_pred, the constant-velocity prediction of the ego-motion T_curr_prev
    * \param[in] intrinsics current-frame intrinsics (§6 reprojection fallback)
    * \param[in] params validated parameters
+   * \param[in] colours frames k-1 and k for the ambiguity test (§4.1); none: no test
    */
   void update(const GridFlowData& grid,
               const SpatialSegmentationResult& spatial,
               const Eigen::Matrix4d& T_pred,
               const CameraIntrinsics& intrinsics,
-              const RigidMotionSegmentationParameters& params);
+              const RigidMotionSegmentationParameters& params,
+              const FramePairColours& colours = {});
 
   /// Ghat per cell: tracked id of the cell's segment this frame (0 = no measurement).
   const std::vector<std::uint8_t>& trackedLabels() const { return tracked_; }
@@ -128,6 +131,28 @@ private:
                         const SpatialSegmentationResult& spatial,
                         const RigidMotionSegmentationParameters& params,
                         std::vector<int>& ids) const;
+
+  /** \brief [D] The cells of an object segment whose tracks the image leaves ambiguous take
+   * label 1 in Ghat (docs/algorithm.md §4.1).
+   *
+   * Repeated texture (a keyboard's keys) lets Lucas-Kanade settle on a neighbouring copy,
+   * and the cells that do so move together, far from the background's motion: a spurious
+   * object. A cell's background position in frame k-1 is its own track p_i moved by the
+   * pixel difference between its 3D end b_i taken back by the inverse of the label-1 segment
+   * `background`'s motion and a_i (both ends are at their depth instants, the track at the
+   * colour instant). A cell is far when that position lies more than 2 r px
+   * (ambiguity_search_radius) from p_i, and ambiguous when it is far and trackIsAmbiguous().
+   * A segment at least half of whose cells are far, and at least half of those ambiguous,
+   * gives its ambiguous cells label 1: the background's motion explains them as well as
+   * their own tracks. Its other cells keep the segment's id.
+   */
+  void settleAmbiguousTracks(const GridFlowData& grid,
+                             const SpatialSegmentationResult& spatial,
+                             const std::vector<int>& ids,
+                             int background,
+                             const CameraIntrinsics& intrinsics,
+                             const FramePairColours& colours,
+                             const RigidMotionSegmentationParameters& params);
 
   /** Marks the ids in use (used_): the static label, the ids of the buffered maps and the
    * argmax of every initialised apparent model. Candidate evidence for any other id is

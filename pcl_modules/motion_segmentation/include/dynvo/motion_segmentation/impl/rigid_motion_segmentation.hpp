@@ -14,6 +14,7 @@
 #include <cstddef>
 #include <numeric>
 #include <stdexcept>
+#include <utility>
 #include <string>
 #include <utility>
 
@@ -232,6 +233,7 @@ RigidMotionSegmentation<PointT>::segmentCells()
   } guard{*this};
   if (!validateInputs())
     return;
+  previous_input_ = std::exchange(last_input_, input_);
   grid_.assign(*flow_, cell_grid_);
   computeInformation();
   segmenter_.segment(grid_, params_, spatial_);
@@ -283,8 +285,20 @@ void
 RigidMotionSegmentation<PointT>::computeImplLabels()
 {
   if (params_.tracking) {
+    // Frames k-1 and k for the ambiguity test (§4.1), when the points have colour.
+    FramePairColours colours;
+    if constexpr (pcl::traits::has_color<PointT>::value) {
+      if (previous_input_ && previous_input_->width == input_->width &&
+          previous_input_->height == input_->height && !input_->empty()) {
+        colours.previous = &(*previous_input_)[0].rgba;
+        colours.current = &(*input_)[0].rgba;
+        colours.stride = sizeof(PointT) / sizeof(float);
+        colours.width = static_cast<int>(input_->width);
+        colours.height = static_cast<int>(input_->height);
+      }
+    }
     tracker_.update(grid_, spatial_, predicted_motion_.cast<double>(), intrinsics_,
-                    params_);
+                    params_, colours);
     cell_grid_.labels = tracker_.labels();
     // [D] Objects younger than n_birth frames are not output yet: most spurious objects of
     // a real static scene last one to three frames. Nor is any object on a frame without a
