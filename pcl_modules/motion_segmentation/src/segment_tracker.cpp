@@ -363,14 +363,15 @@ SegmentTracker::mergeNoiseSplits(const GridFlowData& grid,
 }
 
 void
-SegmentTracker::settleAmbiguousTracks(const GridFlowData& grid,
-                                      const SpatialSegmentationResult& spatial,
-                                      const std::vector<int>& ids,
-                                      int background,
-                                      const CameraIntrinsics& intrinsics,
-                                      const FramePairColours& colours,
-                                      const RigidMotionSegmentationParameters& params)
+SegmentTracker::findAmbiguousObjects(const GridFlowData& grid,
+                                     const SpatialSegmentationResult& spatial,
+                                     const std::vector<int>& ids,
+                                     int background,
+                                     const CameraIntrinsics& intrinsics,
+                                     const FramePairColours& colours,
+                                     const RigidMotionSegmentationParameters& params)
 {
+  ambiguous_.assign(256, 0);
   const int radius = params.ambiguity_search_radius;
   if (radius <= 0 || background == 0 || colours.empty() ||
       colours.width != static_cast<int>(grid.geometry.image_width) ||
@@ -380,7 +381,6 @@ SegmentTracker::settleAmbiguousTracks(const GridFlowData& grid,
       rigidInverse(spatial.motions[background - 1]).cast<float>();
   const int g = spatial.segmentCount();
   std::vector<int> cells(g + 1, 0), far(g + 1, 0), ambiguous(g + 1, 0);
-  std::vector<std::uint8_t> settled(grid.size(), 0);
   const auto far_limit = static_cast<float>(2 * radius);
   for (std::size_t i = 0; i < grid.size(); ++i) {
     const int c = spatial.labels[i];
@@ -397,16 +397,11 @@ SegmentTracker::settleAmbiguousTracks(const GridFlowData& grid,
     if ((q - p).norm() <= far_limit)
       continue;
     ++far[c];
-    if (trackIsAmbiguous(colours, grid.cellCentre(i), p, q, radius)) {
-      ++ambiguous[c];
-      settled[i] = 1;
-    }
+    ambiguous[c] += trackIsAmbiguous(colours, grid.cellCentre(i), p, q, radius) ? 1 : 0;
   }
-  for (std::size_t i = 0; i < grid.size(); ++i) {
-    const int c = spatial.labels[i];
-    if (settled[i] && 2 * far[c] >= cells[c] && 2 * ambiguous[c] >= far[c])
-      tracked_[i] = LABEL_STATIC;
-  }
+  for (int c = 1; c <= g; ++c)
+    if (far[c] > 0 && 2 * far[c] >= cells[c] && 2 * ambiguous[c] >= far[c])
+      ambiguous_[static_cast<std::size_t>(ids[c])] = 1;
 }
 
 void
@@ -678,7 +673,7 @@ SegmentTracker::update(const GridFlowData& grid,
   tracked_.resize(grid.size());
   for (std::size_t i = 0; i < grid.size(); ++i)
     tracked_[i] = static_cast<std::uint8_t>(ids[spatial.labels[i]]);
-  settleAmbiguousTracks(grid, spatial, ids, background, intrinsics, colours, params);
+  findAmbiguousObjects(grid, spatial, ids, background, intrinsics, colours, params);
   keepObjectsApart(grid, spatial, ids, params);
 
   // §6 then §5: carry the models into the current grid, fold in Ghat, read out L.

@@ -83,6 +83,11 @@ public:
    */
   int age(std::uint8_t id) const { return ages_.empty() ? 0 : ages_[id]; }
 
+  /** True when the image leaves the tracks of object `id`'s segment this frame ambiguous
+   * (findAmbiguousObjects()): the background's motion explains its appearance as well.
+   */
+  bool ambiguous(std::uint8_t id) const { return !ambiguous_.empty() && ambiguous_[id]; }
+
   /// Output ids: 1 first, then every object id present in labels(), ascending.
   const std::vector<std::uint8_t>& ids() const { return ids_; }
 
@@ -132,27 +137,27 @@ private:
                         const RigidMotionSegmentationParameters& params,
                         std::vector<int>& ids) const;
 
-  /** \brief [D] The cells of an object segment whose tracks the image leaves ambiguous take
-   * label 1 in Ghat (docs/algorithm.md §4.1).
+  /** \brief [D] The objects whose tracks the image leaves ambiguous this frame
+   * (ambiguous(), docs/algorithm.md §4.1).
    *
    * Repeated texture (a keyboard's keys) lets Lucas-Kanade settle on a neighbouring copy,
    * and the cells that do so move together, far from the background's motion: a spurious
    * object. A cell's background position in frame k-1 is its own track p_i moved by the
-   * pixel difference between its 3D end b_i taken back by the inverse of the label-1 segment
-   * `background`'s motion and a_i (both ends are at their depth instants, the track at the
-   * colour instant). A cell is far when that position lies more than 2 r px
-   * (ambiguity_search_radius) from p_i, and ambiguous when it is far and trackIsAmbiguous().
-   * A segment at least half of whose cells are far, and at least half of those ambiguous,
-   * gives its ambiguous cells label 1: the background's motion explains them as well as
-   * their own tracks. Its other cells keep the segment's id.
+   * pixel difference between its 3D end b_i taken back by the inverse of the label-1
+   * segment `background`'s motion and a_i (both ends are at their depth instants, the
+   * track at the colour instant). A cell is far when that position lies more than 2 r px
+   * (ambiguity_search_radius) from p_i, and ambiguous when it is far and
+   * trackIsAmbiguous(). The id of a segment at least half of whose cells are far, and at
+   * least half of those ambiguous, is ambiguous: the background's motion explains its
+   * cells as well as their own tracks.
    */
-  void settleAmbiguousTracks(const GridFlowData& grid,
-                             const SpatialSegmentationResult& spatial,
-                             const std::vector<int>& ids,
-                             int background,
-                             const CameraIntrinsics& intrinsics,
-                             const FramePairColours& colours,
-                             const RigidMotionSegmentationParameters& params);
+  void findAmbiguousObjects(const GridFlowData& grid,
+                            const SpatialSegmentationResult& spatial,
+                            const std::vector<int>& ids,
+                            int background,
+                            const CameraIntrinsics& intrinsics,
+                            const FramePairColours& colours,
+                            const RigidMotionSegmentationParameters& params);
 
   /** Marks the ids in use (used_): the static label, the ids of the buffered maps and the
    * argmax of every initialised apparent model. Candidate evidence for any other id is
@@ -206,6 +211,7 @@ private:
   std::vector<Eigen::Matrix4d> motions_; ///< motion per output id
   std::vector<char> used_;               ///< ids taken at the start of the frame
   std::vector<int> ages_;                ///< per id: see age()
+  std::vector<char> ambiguous_;          ///< per id: see ambiguous()
 };
 
 } // namespace dynvo

@@ -303,13 +303,16 @@ RigidMotionSegmentation<PointT>::computeImplLabels()
     // [D] Objects younger than n_birth frames are not output yet: most spurious objects of
     // a real static scene last one to three frames. Nor is any object on a frame without a
     // background (no segment agrees with the prediction, §4): nothing was measured to move
-    // against it. The tracker keeps the ids for the next frames.
+    // against it. Nor is an object whose tracks the image leaves ambiguous this frame
+    // (§4.1): the background's motion explains how it looks. The tracker keeps the ids for
+    // the next frames, and the fits leave the held objects' cells out.
     const bool background = hasBackground();
     std::array<bool, 256> held{};
     for (std::size_t s = 0; s < tracker_.ids().size(); ++s) {
       const std::uint8_t id = tracker_.ids()[s];
       held[id] = id != LABEL_STATIC &&
-                 (!background || tracker_.age(id) < params_.object_birth_frames);
+                 (!background || tracker_.age(id) < params_.object_birth_frames ||
+                  tracker_.ambiguous(id));
       if (held[id])
         continue;
       segment_labels_.push_back(id);
