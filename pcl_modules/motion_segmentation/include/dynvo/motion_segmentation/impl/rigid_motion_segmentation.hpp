@@ -14,7 +14,6 @@
 #include <cstddef>
 #include <numeric>
 #include <stdexcept>
-#include <utility>
 #include <string>
 #include <utility>
 
