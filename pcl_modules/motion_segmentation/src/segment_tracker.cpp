@@ -14,6 +14,7 @@
 #include <optional>
 #include <numeric>
 #include <tuple>
+#include <utility>
 
 namespace dynvo {
 
@@ -380,7 +381,9 @@ SegmentTracker::findAmbiguousObjects(const GridFlowData& grid,
   const Eigen::Matrix4f H_inverse =
       rigidInverse(spatial.motions[background - 1]).cast<float>();
   const int g = spatial.segmentCount();
-  std::vector<int> cells(g + 1, 0), far(g + 1, 0), ambiguous(g + 1, 0);
+  // Per segment: its cells, and each far cell with its background position.
+  std::vector<int> cells(g + 1, 0);
+  std::vector<std::vector<std::pair<std::size_t, Eigen::Vector2f>>> far(g + 1);
   const auto far_limit = static_cast<float>(2 * radius);
   for (std::size_t i = 0; i < grid.size(); ++i) {
     const int c = spatial.labels[i];
@@ -394,14 +397,28 @@ SegmentTracker::findAmbiguousObjects(const GridFlowData& grid,
     const Eigen::Vector2f& p = grid.previous_pixel[i];
     const Eigen::Vector2f q =
         p + intrinsics.project(a_background) - intrinsics.project(grid.a[i]);
-    if ((q - p).norm() <= far_limit)
-      continue;
-    ++far[c];
-    ambiguous[c] += trackIsAmbiguous(colours, grid.cellCentre(i), p, q, radius) ? 1 : 0;
+    if ((q - p).norm() > far_limit)
+      far[c].emplace_back(i, q);
   }
-  for (int c = 1; c <= g; ++c)
-    if (far[c] > 0 && 2 * far[c] >= cells[c] && 2 * ambiguous[c] >= far[c])
+  // The image is compared (the costly part) only while the segment's outcome is open: at
+  // least half of its cells far, then until half of those are ambiguous or can no longer be.
+  for (int c = 1; c <= g; ++c) {
+    const auto n_far = static_cast<int>(far[c].size());
+    if (n_far == 0 || 2 * n_far < cells[c])
+      continue;
+    int ambiguous = 0;
+    int left = n_far;
+    for (const auto& [i, q] : far[c]) {
+      if (2 * ambiguous >= n_far || 2 * (ambiguous + left) < n_far)
+        break;
+      --left;
+      if (trackIsAmbiguous(colours, grid.cellCentre(i), grid.previous_pixel[i], q,
+                           radius))
+        ++ambiguous;
+    }
+    if (2 * ambiguous >= n_far)
       ambiguous_[static_cast<std::size_t>(ids[c])] = 1;
+  }
 }
 
 void
