@@ -206,6 +206,22 @@ struct OdometryPipeline::Impl {
     flow_estimation.setPredictedMotion(T_curr_prev_predicted.cast<float>());
     auto flow = pcl::make_shared<pcl::PointCloud<PointFlow>>();
     flow_estimation.compute(*flow);
+    // The flow's search started from the prediction turned onto the image's own shift
+    // (docs/algorithm.md §1.2); the guards compare against it too, within the motion bound.
+    const Eigen::Matrix3f& R_shift = flow_estimation.getPredictionCorrection();
+    if (!R_shift.isIdentity()) {
+      Eigen::Matrix4d turn = Eigen::Matrix4d::Identity();
+      turn.topLeftCorner<3, 3>() = R_shift.transpose().cast<double>();
+      T_curr_prev_predicted = T_curr_prev_predicted * turn;
+      const double share = shareWithinBound(T_curr_prev_predicted, step_dt, options);
+      if (share < 1.0)
+        T_curr_prev_predicted = scaleStep(T_curr_prev_predicted, share);
+      PCL_DEBUG(
+          "[dynvo::app::OdometryPipeline] frame %zu: the prediction turned by %.2f "
+          "deg onto the image's shift\n",
+          frames,
+          Eigen::AngleAxisf(R_shift).angle() * 180.0f / static_cast<float>(EIGEN_PI));
+    }
     result.times.scene_flow_ms = millisecondsSince(flow_start);
     frame_flow = flow;
     startBackendInputs(cloud);

@@ -4,6 +4,7 @@
 #include <dynvo/common/parallel.h>
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
 #include "lucas_kanade.h"
@@ -197,6 +198,44 @@ fillFromNearest(std::vector<Eigen::Vector2f>& values,
   }
 }
 
+/** The rotation that takes the prediction's image shift to the image's own (docs/algorithm.md
+ * §1.2, seeded search): the global shift of `current` into `reference` (grey images of one
+ * pyramid level, `scale` full-resolution pixels per pixel) by phase correlation, against
+ * `predicted`, the prediction's median shift of the cells (px). A rotation about the camera's
+ * y and x axes moves the image centre by the difference. Identity when the difference is
+ * within `reach` px, or when the correlation's peak holds less than MIN_RESPONSE of its
+ * energy (a blurred or featureless image has no shift to measure).
+ */
+Eigen::Matrix3f
+imageShiftRotation(const cv::Mat& current,
+                   const cv::Mat& reference,
+                   float scale,
+                   const Eigen::Vector2f& predicted,
+                   float reach,
+                   const CameraIntrinsics& intrinsics)
+{
+  constexpr double MIN_RESPONSE = 0.1;
+  cv::Mat a, b, window;
+  current.convertTo(a, CV_32F);
+  reference.convertTo(b, CV_32F);
+  cv::createHanningWindow(window, a.size(), CV_32F);
+  double response = 0.0;
+  const cv::Point2d shift = cv::phaseCorrelate(a, b, window, &response);
+  const Eigen::Vector2f d =
+      Eigen::Vector2f(static_cast<float>(shift.x), static_cast<float>(shift.y)) *
+          scale -
+      predicted;
+  if (!(response >= MIN_RESPONSE) || !(d.norm() > reach))
+    return Eigen::Matrix3f::Identity();
+  // About y, a point near the optical axis moves by fx * angle in u; about x, by -fy * angle
+  // in v.
+  return (Eigen::AngleAxisf(std::atan(d.x() / intrinsics.fx),
+                            Eigen::Vector3f::UnitY()) *
+          Eigen::AngleAxisf(-std::atan(d.y() / intrinsics.fy),
+                            Eigen::Vector3f::UnitX()))
+      .toRotationMatrix();
+}
+
 } // namespace
 
 struct GridFlowEngine::Frame {
@@ -310,7 +349,7 @@ GridFlowEngine::depth(Slot slot) const
   return slot == Slot::current ? current_->depth : previous_->depth;
 }
 
-void
+Eigen::Matrix3f
 GridFlowEngine::compute(const GridSceneFlowParameters& params,
                         const CameraIntrinsics& intrinsics,
                         unsigned threads,
@@ -318,9 +357,11 @@ GridFlowEngine::compute(const GridSceneFlowParameters& params,
                         pcl::PointCloud<PointFlow>& flow)
 {
   std::vector<Eigen::Vector2f> velocity;
+  Eigen::Matrix3f shift_rotation;
   track(*previous_, params, intrinsics, threads, T_previous_current, {},
-        params.max_pyramid_level, true, flow, velocity);
+        params.max_pyramid_level, true, flow, velocity, &shift_rotation);
   current_->velocity = std::move(velocity);
+  return shift_rotation;
 }
 
 void
@@ -337,7 +378,8 @@ GridFlowEngine::computeToKeyframe(const GridSceneFlowParameters& params,
         "[dynvo::detail::GridFlowEngine::computeToKeyframe] no keyframe kept");
   std::vector<Eigen::Vector2f> velocity;
   track(*keyframe_, params, intrinsics, threads, T_keyframe_current, selected,
-        std::clamp(max_level, 0, params.max_pyramid_level), false, flow, velocity);
+        std::clamp(max_level, 0, params.max_pyramid_level), false, flow, velocity,
+        nullptr);
 }
 
 void
@@ -350,7 +392,8 @@ GridFlowEngine::track(const Frame& reference,
                       int max_level,
                       bool frame_to_frame,
                       pcl::PointCloud<PointFlow>& flow,
-                      std::vector<Eigen::Vector2f>& velocity) const
+                      std::vector<Eigen::Vector2f>& velocity,
+                      Eigen::Matrix3f* shift_rotation) const
 {
   const Frame& curr = *current_;
   const Frame& prev = reference;
@@ -385,33 +428,59 @@ GridFlowEngine::track(const Frame& reference,
   std::vector<cv::Point2f> seeds;
   tracked_cells.reserve(n);
   seeds.reserve(n);
+  const auto predictSeeds = [&](const Eigen::Matrix3f& R, const Eigen::Vector3f& t) {
+    tracked_cells.clear();
+    seeds.clear();
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!trackable(i))
+        continue;
+      const Eigen::Vector3f q =
+          R * intrinsics.backproject(centres[i].x, centres[i].y, centre_depth[i]) + t;
+      if (!(q.z() > 0.0f))
+        continue;
+      const Eigen::Vector2f seed = intrinsics.project(q);
+      if (!(seed.x() >= 0.0f && seed.y() >= 0.0f && seed.x() <= width - 1.0f &&
+            seed.y() <= height - 1.0f))
+        continue;
+      tracked_cells.push_back(i);
+      seeds.emplace_back(seed.x(), seed.y());
+    }
+  };
   const Eigen::Matrix3f R = T_reference_current.topLeftCorner<3, 3>();
   const Eigen::Vector3f t = T_reference_current.topRightCorner<3, 1>();
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!trackable(i))
-      continue;
-    const Eigen::Vector3f q =
-        R * intrinsics.backproject(centres[i].x, centres[i].y, centre_depth[i]) + t;
-    if (!(q.z() > 0.0f))
-      continue;
-    const Eigen::Vector2f seed = intrinsics.project(q);
-    if (!(seed.x() >= 0.0f && seed.y() >= 0.0f && seed.x() <= width - 1.0f &&
-          seed.y() <= height - 1.0f))
-      continue;
-    tracked_cells.push_back(i);
-    seeds.emplace_back(seed.x(), seed.y());
-  }
-  // Frame to frame, a prediction within the pyramid's reach of the cells (half a window on
-  // the top level: (window / 2) * 2^max_level px, median over the cells) is not needed, and
-  // the search starts at every cell itself.
+  predictSeeds(R, t);
+  if (shift_rotation)
+    shift_rotation->setIdentity();
+  // Frame to frame, the pyramid reaches (window / 2) * 2^max_level px (half a window on the
+  // top level). When the image's own shift departs from the prediction's (medians over the
+  // cells) by more than that, the prediction is turned onto it. A prediction within the
+  // reach of the cells themselves is not needed, and the search starts at every cell itself.
   if (frame_to_frame && !seeds.empty()) {
+    const float reach = 0.5f * static_cast<float>(params.window_size) *
+                        static_cast<float>(1 << max_level);
+    const auto median = [](std::vector<float>& v) {
+      std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+      return v[v.size() / 2];
+    };
+    std::vector<float> x(seeds.size()), y(seeds.size());
+    for (std::size_t k = 0; k < seeds.size(); ++k) {
+      x[k] = seeds[k].x - centres[tracked_cells[k]].x;
+      y[k] = seeds[k].y - centres[tracked_cells[k]].y;
+    }
+    // The image of the top level (the pyramid interleaves images and derivatives).
+    const std::size_t top = 2 * static_cast<std::size_t>(max_level);
+    const Eigen::Matrix3f R_shift = imageShiftRotation(
+        curr.pyramid[top], prev.pyramid[top], static_cast<float>(1 << max_level),
+        Eigen::Vector2f(median(x), median(y)), reach, intrinsics);
+    if (!R_shift.isIdentity()) {
+      predictSeeds(R_shift * R, R_shift * t);
+      if (shift_rotation)
+        *shift_rotation = R_shift;
+    }
     std::vector<float> shift(seeds.size());
     for (std::size_t k = 0; k < seeds.size(); ++k)
       shift[k] = static_cast<float>(cv::norm(seeds[k] - centres[tracked_cells[k]]));
-    std::nth_element(shift.begin(), shift.begin() + shift.size() / 2, shift.end());
-    const float reach = 0.5f * static_cast<float>(params.window_size) *
-                        static_cast<float>(1 << max_level);
-    if (shift[shift.size() / 2] <= reach) {
+    if (!seeds.empty() && median(shift) <= reach) {
       tracked_cells.clear();
       seeds.clear();
       for (std::size_t i = 0; i < n; ++i)

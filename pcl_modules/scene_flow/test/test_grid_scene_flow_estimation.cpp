@@ -615,6 +615,59 @@ TYPED_TEST(GridSceneFlowTest, ResultIsIdenticalForOneAndTwoThreads)
 
 // --- contract ---------------------------------------------------------------------------
 
+TEST(GridSceneFlowPrediction, IsTurnedOntoTheImagesShiftBeyondThePyramidsReach)
+{
+  // VGA, as the pipeline runs: a pan and tilt of 5 and 4 deg with the prediction at rest is
+  // about 59 px of flow at fx = 525 px, beyond the pyramid's reach of (16 / 2) * 2^2 =
+  // 32 px, as a hand-held sweep whose velocity changed after a dropped frame.
+  constexpr std::uint32_t WIDTH = 640, HEIGHT = 480;
+  const CameraIntrinsics intrinsics = scaledIntrinsics(WIDTH);
+  const auto view = [&](const Eigen::Isometry3d& T_world_camera) {
+    return dynvo::test::render<pcl::PointXYZRGB>(staticRoom(), T_world_camera,
+                                                 intrinsics, WIDTH, HEIGHT)
+        .cloud;
+  };
+  const Eigen::Isometry3d T_prev_curr = pose(-4.0, 5.0, 0.0, 0.0, 0.0, 0.0);
+  const auto previous = view(Eigen::Isometry3d::Identity());
+  const auto current = view(T_prev_curr);
+  dynvo::GridSceneFlowEstimation<pcl::PointXYZRGB> estimation;
+  estimation.setCameraIntrinsics(intrinsics);
+  FlowCloud flow;
+  const auto run = [&] {
+    estimation.setPreviousCloud(previous);
+    estimation.setInputCloud(current);
+    estimation.compute(flow);
+    expectCellContract(flow);
+  };
+  run();
+  // The correction is the rotation the image shows: phase correlation on the 160 x 120 top
+  // level measures the shift to about a pixel there (4 px, 0.4 deg at VGA), and the image's
+  // edges move a few pixels more than its centre.
+  const Eigen::Matrix3d R_shift = estimation.getPredictionCorrection().cast<double>();
+  EXPECT_LT(Eigen::AngleAxisd(R_shift.transpose() * T_prev_curr.linear()).angle(),
+            dynvo::test::radians(1.0));
+  // Seeded from it, the cells are tracked as precisely as a small motion
+  // (KnownCameraMotionIsRecoveredForwardAndInverse: 0.2 px); about a tenth of the image
+  // leaves the view.
+  std::vector<double> error_2d;
+  for (const PointFlow& f : flow)
+    if (f.valid_3d)
+      error_2d.push_back(
+          (Eigen::Vector2f(f.prev_u, f.prev_v) -
+           intrinsics.project((T_prev_curr * currPoint(f)).cast<float>()))
+              .norm());
+  ASSERT_GE(error_2d.size(), flow.size() * 7 / 10);
+  EXPECT_LT(median(error_2d), 0.2);
+
+  // A prediction within the reach of the motion (1 deg off, 9 px) is kept as it is.
+  estimation.setPredictedMotion((T_prev_curr * pose(0.0, 1.0, 0.0, 0.0, 0.0, 0.0))
+                                    .inverse()
+                                    .matrix()
+                                    .cast<float>());
+  run();
+  EXPECT_TRUE(estimation.getPredictionCorrection().isIdentity());
+}
+
 class GridSceneFlowContractTest : public ::testing::Test {
 protected:
   using Cloud = pcl::PointCloud<pcl::PointXYZRGB>;

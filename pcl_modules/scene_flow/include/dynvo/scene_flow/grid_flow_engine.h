@@ -75,16 +75,21 @@ public:
    * moves the cells farther than the pyramid reaches ((window_size / 2) * 2^max_pyramid_level
    * px, median over the cells), every cell starts at its predicted position in the previous
    * frame, the projection of T_previous_current * b_i; otherwise every cell starts where it
-   * is. Cells without depth at c_i are not tracked. The whole pyramid is searched. The
-   * current slot keeps each cell's image velocity (px/s) for the depth instants of later
-   * fits; a cell without a track takes its nearest tracked cell's (docs/algorithm.md §1.2).
+   * is. Before that, when the image's own shift (phase correlation of the pyramids' top
+   * levels) departs from the prediction's by more than that reach, the prediction is first
+   * turned by the rotation that moves its shift onto the image's. Cells without depth at
+   * c_i are not tracked. The whole pyramid is searched. The current slot keeps each cell's
+   * image velocity (px/s) for the depth instants of later fits; a cell without a track
+   * takes its nearest tracked cell's (docs/algorithm.md §1.2).
    * \param[out] flow organized (width / cell_size) x (height / cell_size) cloud
+   * \return that rotation R (T_previous_current became [R 0; 0 1] * T_previous_current);
+   * identity when the prediction was kept
    */
-  void compute(const GridSceneFlowParameters& params,
-               const CameraIntrinsics& intrinsics,
-               unsigned threads,
-               const Eigen::Matrix4f& T_previous_current,
-               pcl::PointCloud<PointFlow>& flow);
+  Eigen::Matrix3f compute(const GridSceneFlowParameters& params,
+                          const CameraIntrinsics& intrinsics,
+                          unsigned threads,
+                          const Eigen::Matrix4f& T_previous_current,
+                          pcl::PointCloud<PointFlow>& flow);
 
   /** \brief Grid scene flow from the keyframe to the current slot, seeded (docs/algorithm.md
    * §7.3): each selected cell with depth b_i starts at the projection of
@@ -110,9 +115,10 @@ private:
 
   /** Tracks the selected cells of the current slot into reference, each from its
    * predicted position under T_reference_current, and back-projects both ends at their
-   * frames' depth instants: compute() (frame_to_frame: a cell starts from itself when the
-   * prediction moves the cells by no more than the pyramid reaches, median over the cells;
-   * the cell's image velocity is that of this track, returned in velocity) and
+   * frames' depth instants: compute() (frame_to_frame: the prediction first turned onto
+   * the image's shift, the rotation returned in shift_rotation; a cell starts from itself
+   * when the prediction moves the cells by no more than the pyramid reaches, median over
+   * the cells; the cell's image velocity is that of this track, returned in velocity) and
    * computeToKeyframe() (the velocities kept by each frame's compute()).
    */
   void track(const Frame& reference,
@@ -124,7 +130,8 @@ private:
              int max_level,
              bool frame_to_frame,
              pcl::PointCloud<PointFlow>& flow,
-             std::vector<Eigen::Vector2f>& velocity) const;
+             std::vector<Eigen::Vector2f>& velocity,
+             Eigen::Matrix3f* shift_rotation) const;
 
   std::shared_ptr<Frame> current_;
   std::shared_ptr<Frame> previous_;

@@ -133,6 +133,16 @@ public:
 
   const Eigen::Matrix4f& getPredictedMotion() const { return predicted_motion_; }
 
+  /** \brief The rotation R by which the last compute() turned the predicted motion onto the
+   * image's own shift, when the two departed by more than the pyramid reaches
+   * (docs/algorithm.md §1.2): its cells were seeded from H_pred * [R^T 0; 0 1]. Identity
+   * when the prediction was kept.
+   */
+  const Eigen::Matrix3f& getPredictionCorrection() const
+  {
+    return prediction_correction_;
+  }
+
   /** \brief Keeps the current frame of the last compute() as the keyframe (its pyramid and
    * depth map are shared, not copied), replacing the previous keyframe.
    * \return false (logged with PCL_ERROR) when compute() has not prepared the input cloud
@@ -234,6 +244,8 @@ private:
   std::array<std::shared_ptr<std::vector<float>>, 2> depth_buffers_;
   std::vector<std::uint8_t> selected_; ///< cells computeToKeyframe() tracks
   Eigen::Matrix4f predicted_motion_ = Eigen::Matrix4f::Identity(); ///< H_pred
+  /// getPredictionCorrection()
+  Eigen::Matrix3f prediction_correction_ = Eigen::Matrix3f::Identity();
 };
 
 } // namespace dynvo

@@ -165,6 +165,7 @@ void
 GridSceneFlowEstimation<PointT>::compute(FlowCloud& flow)
 {
   flow.clear();
+  prediction_correction_.setIdentity();
   params_.validate(); // the per-field setters leave the cross-field rules to here
   if (!initCompute())
     return;
@@ -196,8 +197,9 @@ GridSceneFlowEstimation<PointT>::compute(FlowCloud& flow)
                  grey, depth);
   }
   previous_ready_ = true;
-  engine_.compute(params_, intrinsics_, threads_,
-                  rigidInverse(predicted_motion_.cast<double>()).cast<float>(), flow);
+  prediction_correction_ = engine_.compute(
+      params_, intrinsics_, threads_,
+      rigidInverse(predicted_motion_.cast<double>()).cast<float>(), flow);
   flow.header = input_->header;
 }
 
