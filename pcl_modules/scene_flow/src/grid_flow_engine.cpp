@@ -204,7 +204,7 @@ fillFromNearest(std::vector<Eigen::Vector2f>& values,
  * `predicted`, the prediction's median shift of the cells (px). A rotation about the camera's
  * y and x axes moves the image centre by the difference. Identity when the difference is
  * within `reach` px, or when the correlation's peak holds less than MIN_RESPONSE of its
- * energy (a blurred or featureless image has no shift to measure).
+ * energy (a blurred or featureless image has no shift to measure), or the images are tiny.
  */
 Eigen::Matrix3f
 imageShiftRotation(const cv::Mat& current,
@@ -215,6 +215,10 @@ imageShiftRotation(const cv::Mat& current,
                    const CameraIntrinsics& intrinsics)
 {
   constexpr double MIN_RESPONSE = 0.1;
+  constexpr int MIN_SIDE = 8; // a smaller top level has no shift worth measuring
+  if (current.cols < MIN_SIDE || current.rows < MIN_SIDE ||
+      current.size() != reference.size())
+    return Eigen::Matrix3f::Identity();
   cv::Mat a, b, window;
   current.convertTo(a, CV_32F);
   reference.convertTo(b, CV_32F);
