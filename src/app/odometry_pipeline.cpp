@@ -74,6 +74,15 @@ scaleStep(const Eigen::Matrix4d& T_curr_prev, double x)
       .matrix();
 }
 
+/// The step T_curr_prev, scaled down to its share within the motion bound over dt seconds
+/// (shareWithinBound()) when it lies beyond it.
+Eigen::Matrix4d
+boundedStep(const Eigen::Matrix4d& T_curr_prev, double dt, const PipelineOptions& o)
+{
+  const double share = shareWithinBound(T_curr_prev, dt, o);
+  return share < 1.0 ? scaleStep(T_curr_prev, share) : T_curr_prev;
+}
+
 /// RMS distance (metres) by which the step T_curr_prev moves the previous-frame points a_i
 /// of the valid flow cells; 0 without any.
 double
@@ -212,10 +221,7 @@ struct OdometryPipeline::Impl {
     if (!R_shift.isIdentity()) {
       Eigen::Matrix4d turn = Eigen::Matrix4d::Identity();
       turn.topLeftCorner<3, 3>() = R_shift.transpose().cast<double>();
-      T_curr_prev_predicted = T_curr_prev_predicted * turn;
-      const double share = shareWithinBound(T_curr_prev_predicted, step_dt, options);
-      if (share < 1.0)
-        T_curr_prev_predicted = scaleStep(T_curr_prev_predicted, share);
+      T_curr_prev_predicted = boundedStep(T_curr_prev_predicted * turn, step_dt, options);
       PCL_DEBUG(
           "[dynvo::app::OdometryPipeline] frame %zu: the prediction turned by %.2f "
           "deg onto the image's shift\n",
@@ -690,9 +696,7 @@ OdometryPipeline::process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& clo
                              : 1.0;
     const Eigen::Matrix4d velocity_step =
         ratio != 1.0 ? scaleStep(p.last_step, ratio) : p.last_step;
-    const double share = shareWithinBound(velocity_step, p.step_dt, p.options);
-    p.T_curr_prev_predicted =
-        share < 1.0 ? scaleStep(velocity_step, share) : velocity_step;
+    p.T_curr_prev_predicted = boundedStep(velocity_step, p.step_dt, p.options);
     if (std::isfinite(colour_dt) && colour_dt > 0.0)
       p.last_colour_dt = colour_dt;
     p.track(cloud, depth_stamp);
