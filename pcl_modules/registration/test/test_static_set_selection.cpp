@@ -1,4 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <dynvo/common/rigid_fit.h>
 #include <dynvo/registration/static_set_selection.h>
 
 #include "registration_scene.h"
@@ -73,6 +74,16 @@ protected:
               TRANSLATION_TOL);
     EXPECT_LT(rotationError(registration_.getFinalTransformation(), truth()),
               ROTATION_TOL);
+  }
+
+  /// The static set of the last align() is exactly the cells that see the static scene.
+  void expectStaticSetIsTheScene() const
+  {
+    const FlowGrid& selected = selection_.getStaticCells();
+    ASSERT_EQ(selected.size(), pair_.static_cells.size());
+    for (std::size_t i = 0; i < selected.size(); ++i)
+      EXPECT_EQ(selected.labels[i] == LABEL_STATIC, pair_.static_cells[i] == 1)
+          << "cell " << i;
   }
 
   BoxScene scene_;
@@ -164,6 +175,38 @@ TEST_F(Selection, MotionGuardOverridesABackgroundLabelOnTheMovingBox)
   EXPECT_GT(translationError(registration_.getFinalTransformation(), truth()), 0.03);
 }
 
+TEST_F(Selection, ANearBodyGivesWayToTheLargerSurface)
+{
+  // VGA, so that the moving box (0.6 m across at 1.6 m) covers about 140 cells and the room
+  // (2-3.5 m) about 900: the room's surface (sum z^2) is over 10 times the box's. Only the box
+  // is labelled static, the room is unlabelled, and the prediction is the box's motion, so
+  // the first fit, the guard and the consensus all take the box (docs/algorithm.md §7.8).
+  scene_ = BoxScene::make(640, 480);
+  pair_ = FramePair<pcl::PointXYZRGB>(scene_);
+  pair_.feed(registration_);
+  FlowGrid labels = swappedLabels();
+  for (std::uint8_t& label : labels.labels)
+    label = label == LABEL_OBJECT ? LABEL_NONE : label;
+  selection_.setCellLabels(labels);
+  selection_.setStaticConsensus(0.0f);
+  ASSERT_TRUE(selection_.align(registration_));
+  const Eigen::Matrix4d T_prev_curr_box =
+      registration_.getFinalTransformation().cast<double>();
+  ASSERT_GT(translationError(registration_.getFinalTransformation(), truth()), 0.03);
+  selection_.setPredictedMotion(dynvo::rigidInverse(T_prev_curr_box));
+  selection_.setStaticConsensus(2.0f);
+  ASSERT_TRUE(selection_.align(registration_));
+  EXPECT_TRUE(selection_.getLabelsTrusted());
+  // The cells the consensus left out move as one body, the room: it is the background.
+  expectTruth();
+  expectStaticSetIsTheScene();
+
+  // Labelled an object, the room is not a rival: the box stays (the labels are trusted).
+  selection_.setCellLabels(swappedLabels());
+  ASSERT_TRUE(selection_.align(registration_));
+  EXPECT_GT(translationError(registration_.getFinalTransformation(), truth()), 0.03);
+}
+
 TEST_F(Selection, MovingCellsAreLeftOutOfEveryFitWhateverTheirLabel)
 {
   // The segmentation merged the moving box into the background (every valid cell labelled
@@ -185,10 +228,7 @@ TEST_F(Selection, MovingCellsAreLeftOutOfEveryFitWhateverTheirLabel)
   ASSERT_TRUE(selection_.align(registration_));
   EXPECT_TRUE(selection_.getLabelsTrusted());
   expectTruth();
-  const FlowGrid& selected = selection_.getStaticCells();
-  for (std::size_t i = 0; i < selected.size(); ++i)
-    EXPECT_EQ(selected.labels[i] == LABEL_STATIC, pair_.static_cells[i] == 1)
-        << "cell " << i;
+  expectStaticSetIsTheScene();
 
   // Without labels too (every other valid cell is static).
   selection_.clearCellLabels();

@@ -17,7 +17,7 @@
 namespace dynvo {
 
 /** \brief Chooses the static cells of a frame and drives StaticSceneRegistration on them
- * (docs/algorithm.md §7): up to three fits per frame.
+ * (docs/algorithm.md §7): up to four fits per frame.
  *
  * 1. First fit on the segmentation's static cells (setCellLabels(): cells labelled
  *    LABEL_STATIC), started from the prediction H_pred (setPredictedMotion()).
@@ -30,9 +30,12 @@ namespace dynvo {
  *    m^2), leaving out the cells labelled as objects (label > LABEL_STATIC) when the labels
  *    are trusted. Background cells the segmentation split off count again; moving objects
  *    stay out.
+ * 4. Surface contest: the valid cells step 3 left out are fitted on their own; when that
+ *    motion's consensus covers more than twice the surface of step 3's (sum of z^2), it is
+ *    the background's, and its cells and motion replace step 3's.
  * The moving cells of setMovingCells() (MotionEvidence's, docs/algorithm.md §7.6) are left
  * out of every step whatever their label.
- * Steps 2 and 3 run only when static_consensus > 0. Without labels (clearCellLabels(), the
+ * Steps 2 to 4 run only when static_consensus > 0. Without labels (clearCellLabels(), the
  * default) every valid flow cell is static and only step 1 runs (the pipeline's ablation
  * without segmentation). Labels whose grid is not the flow's (e.g. the empty grid of a failed
  * segmentation) select no cell for step 1 and are never trusted.
@@ -141,6 +144,16 @@ private:
                        const Eigen::Matrix4d& T_prev_curr,
                        bool exclude_objects,
                        double limit);
+
+  /** Step 4 (docs/algorithm.md §7.8): the valid cells the consensus left out (not moving,
+   * not objects when the labels are trusted) fitted on their own, and that motion's
+   * consensus. When it holds more than twice the consensus' surface in the world, it is the
+   * background: static_cells_ and T_prev_curr become its; else static_cells_ is restored.
+   */
+  void contestBackground(Registration& registration,
+                         const FlowCloud& flow,
+                         double limit,
+                         Eigen::Matrix4d& T_prev_curr);
 
   /// Cell i (of static_cells_' grid) is among the moving cells of setMovingCells().
   bool leftOut(std::size_t i) const

@@ -5,6 +5,8 @@
 #include <dynvo/common/rigid_fit.h>
 #include <dynvo/registration/static_set_selection.h>
 
+#include <pcl/console/print.h>
+
 namespace dynvo {
 
 template <typename PointT>
@@ -89,9 +91,63 @@ StaticSetSelection<PointT>::align(Registration& registration)
                       ? registration.getFinalTransformation().template cast<double>()
                       : T_prev_curr_predicted;
   }
-  selectConsensus(*flow, T_prev_curr, labels_trusted_,
-                  static_cast<double>(params_.static_consensus) * inlier_threshold_);
+  const double limit =
+      static_cast<double>(params_.static_consensus) * inlier_threshold_;
+  selectConsensus(*flow, T_prev_curr, labels_trusted_, limit);
+  contestBackground(registration, *flow, limit, T_prev_curr);
   return fit(registration, T_prev_curr, true);
+}
+
+template <typename PointT>
+void
+StaticSetSelection<PointT>::contestBackground(Registration& registration,
+                                              const FlowCloud& flow,
+                                              double limit,
+                                              Eigen::Matrix4d& T_prev_curr)
+{
+  // docs/algorithm.md §7.8. Fewer cells than MIN_BODY_CELLS are not a body. The rival must
+  // show more than SURFACE_RATIO times the consensus' surface: a large mover's visible
+  // surface can match the room's (synthetic large_box_slow, 1.0 x 1.6 m at 2.7 m).
+  constexpr std::size_t MIN_BODY_CELLS = 30;
+  constexpr double SURFACE_RATIO = 2.0;
+  const FlowGrid consensus = static_cells_;
+  std::size_t rest = 0;
+  for (std::size_t i = 0; i < flow.size(); ++i) {
+    const bool candidate = flow[i].valid_3d && !leftOut(i) &&
+                           !(labels_trusted_ && labels_.labels[i] > LABEL_STATIC) &&
+                           consensus.labels[i] != LABEL_STATIC;
+    static_cells_.labels[i] = candidate ? LABEL_STATIC : LABEL_NONE;
+    rest += candidate ? 1 : 0;
+  }
+  // A cell of side s px at depth z covers (s z / f)^2 m^2: sum z^2 is the body's surface up
+  // to a constant factor.
+  const auto surface = [&flow](const FlowGrid& cells, std::size_t& count) {
+    double sum = 0.0;
+    count = 0;
+    for (std::size_t i = 0; i < flow.size(); ++i)
+      if (cells.labels[i] == LABEL_STATIC) {
+        sum += static_cast<double>(flow[i].z) * flow[i].z;
+        ++count;
+      }
+    return sum;
+  };
+  if (rest >= MIN_BODY_CELLS && fit(registration, T_prev_curr, false)) {
+    const Eigen::Matrix4d T_rival =
+        registration.getFinalTransformation().template cast<double>();
+    selectConsensus(flow, T_rival, labels_trusted_, limit);
+    std::size_t held = 0, rival = 0;
+    const double held_surface = surface(consensus, held);
+    const double rival_surface = surface(static_cells_, rival);
+    if (held >= MIN_BODY_CELLS && rival >= MIN_BODY_CELLS &&
+        rival_surface > SURFACE_RATIO * held_surface) {
+      PCL_DEBUG("[dynvo::%s::align] the cells left out move as a body of %zu cells, "
+                "%.1f times the surface of the consensus' %zu: it is the background.\n",
+                getClassName().c_str(), rival, rival_surface / held_surface, held);
+      T_prev_curr = T_rival;
+      return;
+    }
+  }
+  static_cells_ = consensus;
 }
 
 } // namespace dynvo
