@@ -155,6 +155,14 @@ private:
                          double limit,
                          Eigen::Matrix4d& T_prev_curr);
 
+  /// Cell i may enter a static set: it has 3D flow, is not among the moving cells, and is
+  /// not labelled as an object when exclude_objects.
+  bool eligible(const FlowCloud& flow, std::size_t i, bool exclude_objects) const
+  {
+    return flow[i].valid_3d && !(exclude_objects && labels_.labels[i] > LABEL_STATIC) &&
+           !leftOut(i);
+  }
+
   /// Cell i (of static_cells_' grid) is among the moving cells of setMovingCells().
   bool leftOut(std::size_t i) const
   {

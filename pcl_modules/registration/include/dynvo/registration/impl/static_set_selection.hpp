@@ -40,8 +40,7 @@ StaticSetSelection<PointT>::selectConsensus(const FlowCloud& flow,
   for (std::size_t i = 0; i < flow.size(); ++i) {
     const PointFlow& cell = flow[i];
     const bool selected =
-        cell.valid_3d && !(exclude_objects && labels_.labels[i] > LABEL_STATIC) &&
-        !leftOut(i) &&
+        eligible(flow, i, exclude_objects) &&
         squaredTransferError(T_prev_curr, cell.getVector3fMap().cast<double>(),
                              Eigen::Vector3d(cell.prev_x, cell.prev_y, cell.prev_z)) <=
             limit;
@@ -64,8 +63,7 @@ StaticSetSelection<PointT>::align(Registration& registration)
   }
   if (!use_labels_) {
     for (std::size_t i = 0; i < flow->size(); ++i)
-      static_cells_.labels[i] =
-          (*flow)[i].valid_3d && !leftOut(i) ? LABEL_STATIC : LABEL_NONE;
+      static_cells_.labels[i] = eligible(*flow, i, false) ? LABEL_STATIC : LABEL_NONE;
     return fit(registration, rigidInverse(T_curr_prev_predicted_), true);
   }
   const bool labels_fit = labels_.sameGeometry(static_cells_) &&
@@ -113,9 +111,8 @@ StaticSetSelection<PointT>::contestBackground(Registration& registration,
   const FlowGrid consensus = static_cells_;
   std::size_t rest = 0;
   for (std::size_t i = 0; i < flow.size(); ++i) {
-    const bool candidate = flow[i].valid_3d && !leftOut(i) &&
-                           !(labels_trusted_ && labels_.labels[i] > LABEL_STATIC) &&
-                           consensus.labels[i] != LABEL_STATIC;
+    const bool candidate =
+        eligible(flow, i, labels_trusted_) && consensus.labels[i] != LABEL_STATIC;
     static_cells_.labels[i] = candidate ? LABEL_STATIC : LABEL_NONE;
     rest += candidate ? 1 : 0;
   }
