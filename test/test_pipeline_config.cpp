@@ -67,7 +67,7 @@ TEST(PipelineConfig, EveryKeyOfEveryTableRoundTripsThroughTheFile)
   // The table is the concatenation of the module tables and the pipeline's own, so a field
   // added to any of them (and its table, which a static_assert enforces) is covered here.
   const auto& fields = dynvo::app::pipelineConfigTable().fields();
-  ASSERT_EQ(fields.size(), 17u + 37u + 6u + 7u + 2u + 1u + 3u + 9u);
+  ASSERT_EQ(fields.size(), 17u + 37u + 6u + 7u + 2u + 1u + 3u + 10u);
   const PipelineOptions defaults;
   const PipelineOptions changed = everyFieldChanged();
   ASSERT_NO_THROW(changed.validate());

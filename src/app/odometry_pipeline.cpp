@@ -721,7 +721,12 @@ OdometryPipeline::process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& clo
     // the last step, taken from two poses, feeds the error back through the prediction on
     // lost frames until it diverges (docs/algorithm.md §7.5).
     orthonormalize(result.T_world_curr);
-    p.last_step = result.T_curr_prev;
+    // An unmeasured velocity fades (docs/algorithm.md §7.5): over a run of lost frames the
+    // prediction comes to rest instead of carrying the last step on.
+    p.last_step = result.lost
+                      ? scaleStep(result.T_curr_prev,
+                                  std::exp(-p.step_dt / p.options.velocity_memory))
+                      : result.T_curr_prev;
     if (p.options.use_segmentation && !result.lost)
       p.evidence.update(*p.frame_flow, rigidInverse(result.T_curr_prev));
   }

@@ -76,6 +76,8 @@ PipelineOptions::table()
                 "fits moving the camera faster are rejected (m/s)"),
       makeField("max_rotation_rate", &P::max_rotation_rate, R::above(0),
                 "fits turning the camera faster are rejected (rad/s)"),
+      makeField("velocity_memory", &P::velocity_memory, R::above(0),
+                "time constant of the velocity's fading over lost frames (s)"),
       makeField("guard_motion_factor", &P::guard_motion_factor, R::atLeast(0),
                 "motion guard tolerance grows by this share of the predicted motion"),
   });
@@ -109,7 +111,7 @@ pipelineConfigTable()
                     own.field("keyframe_min_overlap"),
                     own.field("keyframe_max_distance"), own.field("keyframe_max_angle"),
                     own.field("max_speed"), own.field("max_rotation_rate"),
-                    own.field("guard_motion_factor")})};
+                    own.field("velocity_memory"), own.field("guard_motion_factor")})};
   return table;
 }
 
