@@ -83,6 +83,21 @@ boundedStep(const Eigen::Matrix4d& T_curr_prev, double dt, const PipelineOptions
   return share < 1.0 ? scaleStep(T_curr_prev, share) : T_curr_prev;
 }
 
+/// How far the velocity of the last measured step (taken over step_interval seconds) carries
+/// the camera between `since` and `since + interval` seconds after that step's frame, in
+/// steps (docs/algorithm.md §7.5): it holds for `hold` seconds, then fades with the time
+/// constant `memory`.
+double
+velocityReach(
+    double since, double interval, double hold, double step_interval, double memory)
+{
+  const auto reach = [&](double t) {
+    return (t <= hold ? t : hold - memory * std::expm1(-(t - hold) / memory)) /
+           step_interval;
+  };
+  return reach(since + interval) - reach(since);
+}
+
 /// RMS distance (metres) by which the step T_curr_prev moves the previous-frame points a_i
 /// of the valid flow cells; 0 without any.
 double
@@ -323,6 +338,27 @@ struct OdometryPipeline::Impl {
       keyframe_inliers = 0;
       result.keyframe = true;
     }
+  }
+
+  /// The colour interval dt (s) from the previous frame; one that is not positive (stamps
+  /// not increasing) counts as the last measured one.
+  double colourInterval(double dt) const
+  {
+    return std::isfinite(dt) && dt > 0.0 ? dt : last_colour_dt;
+  }
+
+  /// The last measured step carried over the colour interval dt that follows the previous
+  /// frame (velocityReach()), within the motion bound over bound_dt. The velocity holds up
+  /// to the first frame after the measured one, good or bad: the whole step is the flow's
+  /// best seed (docs/algorithm.md §7.5).
+  Eigen::Matrix4d predictStep(double dt, double bound_dt)
+  {
+    if (hold == 0.0)
+      hold = dt;
+    const double x =
+        velocityReach(unmeasured, dt, hold, last_colour_dt, options.velocity_memory);
+    return boundedStep(x != 1.0 ? scaleStep(last_step, x) : last_step, bound_dt,
+                       options);
   }
 
   /// The step T_curr_prev lies within the motion bound over this frame's step_dt.
@@ -624,9 +660,12 @@ struct OdometryPipeline::Impl {
   /// H_pred of this frame: the last step, scaled down to the motion bound over step_dt
   Eigen::Matrix4d T_curr_prev_predicted = Eigen::Matrix4d::Identity();
   Eigen::Matrix4d last_step =
-      Eigen::Matrix4d::Identity(); ///< T_curr_prev of the last frame
-  double step_dt = 1.0 / 30.0;     ///< this frame's interval (s), the bound's duration
-  double last_colour_dt = 1.0 / 30.0; ///< the last positive colour interval (s)
+      Eigen::Matrix4d::Identity();    ///< T_curr_prev of the last measured frame
+  double last_colour_dt = 1.0 / 30.0; ///< that frame's colour interval (s)
+  /// seconds from the last measured frame to the previous frame (lost frames between)
+  double unmeasured = 0.0;
+  double hold = 0.0; ///< seconds the velocity holds after that frame (0: no frame yet)
+  double step_dt = 1.0 / 30.0; ///< this frame's interval (s), the bound's duration
   std::size_t frames = 0;
   FrameResult result;
   /// the second thread (threads > 1); last, so that it ends before the members its tasks use
@@ -661,7 +700,8 @@ OdometryPipeline::process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& clo
              timestamp, result.error.c_str());
     result.lost = true;
     result.lost_reason = LostReason::bad_frame;
-    result.T_curr_prev = p.last_step;
+    const double dt = p.colourInterval(timestamp - p.previous_stamp);
+    result.T_curr_prev = p.predictStep(dt, dt);
     result.T_world_curr = p.T_world_prev * rigidInverse(result.T_curr_prev);
     result.labels.assign(static_cast<std::size_t>(result.width) * result.height,
                          LABEL_NONE);
@@ -683,22 +723,14 @@ OdometryPipeline::process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& clo
     result.motions.assign(1, Eigen::Matrix4f::Identity());
   }
   else {
-    // Constant velocity over time (docs/algorithm.md §7.5): the last step scaled by the
-    // ratio of the colour intervals (a dropped frame doubles the step), within the motion
-    // bound. The bound holds over the longer of the colour and depth intervals (TUM fr1 drops
-    // colour and depth frames at different instants); an interval that is not positive
-    // (stamps not increasing) counts as the last one.
-    const double colour_dt = timestamp - p.previous_stamp;
+    // The velocity over time (docs/algorithm.md §7.5): the last measured step carried over
+    // the colour interval, within the motion bound. The bound holds over the longer of the
+    // colour and depth intervals (TUM fr1 drops colour and depth frames at different
+    // instants).
+    const double colour_dt = p.colourInterval(timestamp - p.previous_stamp);
     const double dt = std::max(colour_dt, depth_stamp - p.previous_depth_stamp);
     p.step_dt = std::isfinite(dt) && dt > 0.0 ? dt : p.step_dt;
-    const double ratio = std::isfinite(colour_dt) && colour_dt > 0.0
-                             ? colour_dt / p.last_colour_dt
-                             : 1.0;
-    const Eigen::Matrix4d velocity_step =
-        ratio != 1.0 ? scaleStep(p.last_step, ratio) : p.last_step;
-    p.T_curr_prev_predicted = boundedStep(velocity_step, p.step_dt, p.options);
-    if (std::isfinite(colour_dt) && colour_dt > 0.0)
-      p.last_colour_dt = colour_dt;
+    p.T_curr_prev_predicted = p.predictStep(colour_dt, p.step_dt);
     p.track(cloud, depth_stamp);
     result.T_world_curr = p.T_world_prev * rigidInverse(result.T_curr_prev);
     // The keyframe fit is the flow and direct backends'; the others run frame to frame.
@@ -721,12 +753,16 @@ OdometryPipeline::process(const pcl::PointCloud<pcl::PointXYZRGB>::ConstPtr& clo
     // the last step, taken from two poses, feeds the error back through the prediction on
     // lost frames until it diverges (docs/algorithm.md §7.5).
     orthonormalize(result.T_world_curr);
-    // An unmeasured velocity fades (docs/algorithm.md §7.5): over a run of lost frames the
-    // prediction comes to rest instead of carrying the last step on.
-    p.last_step = result.lost
-                      ? scaleStep(result.T_curr_prev,
-                                  std::exp(-p.step_dt / p.options.velocity_memory))
-                      : result.T_curr_prev;
+    // A lost frame measures no velocity: the last measured one goes on fading over it.
+    if (result.lost) {
+      p.unmeasured += colour_dt;
+    }
+    else {
+      p.last_step = result.T_curr_prev;
+      p.last_colour_dt = colour_dt;
+      p.unmeasured = 0.0;
+      p.hold = 0.0;
+    }
     if (p.options.use_segmentation && !result.lost)
       p.evidence.update(*p.frame_flow, rigidInverse(result.T_curr_prev));
   }

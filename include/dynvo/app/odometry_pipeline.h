@@ -75,11 +75,12 @@ struct DYNVO_EXPORTS PipelineOptions {
   /// the constant-velocity prediction is scaled down to the same bound.
   double max_speed = 3.0;
   double max_rotation_rate = 4.0; ///< rad/s (229 deg/s)
-  /// Time constant (s) with which the velocity fades while no frame measures it
-  /// (docs/algorithm.md §7.5): each lost frame passes on its step times exp(-dt / this), so
-  /// over a blind stretch of any length the prediction moves the camera about the last
-  /// velocity times this many seconds in all. 0.3 s: how long a hand-held camera's measured
-  /// step still predicts its motion.
+  /// Time constant (s) with which the last measured velocity fades while no frame measures
+  /// it (docs/algorithm.md §7.5): it holds up to the first frame after the measured one,
+  /// then fades, so over a blind stretch of any length (lost or bad frames) the prediction
+  /// moves the camera about the last velocity times one frame interval plus this many
+  /// seconds in all. 0.3 s: how long a hand-held camera's measured step still predicts its
+  /// motion.
   double velocity_memory = 0.3;
   /// The motion guard's tolerance (segmentation.static_guard_tolerance, tau_cv) grows by
   /// this share of the RMS distance the predicted motion moves the flow's points: a
