@@ -86,13 +86,8 @@ trackIsAmbiguous(const FramePairColours& colours,
   for (const float v : a)
     mean += v;
   mean /= AREA;
-  float variance = 0.0f;
-  for (float& v : a) {
+  for (float& v : a)
     v -= mean;
-    variance += v * v;
-  }
-  if (variance / AREA < MIN_TEXTURE_VARIANCE)
-    return false;
   const int own_side = SIDE + 2, other_side = SIDE + 2 * radius;
   std::vector<float> own(static_cast<std::size_t>(own_side) * own_side),
       elsewhere(static_cast<std::size_t>(other_side) * other_side);

@@ -29,9 +29,8 @@ struct FramePairColours {
  * differences) with the patches of frame k-1 at integer positions: within 1 px of `track`
  * (where the cell's own flow puts it) and within `radius` px of `other` (where another
  * motion puts it). The track is ambiguous when the other position matches at most
- * AMBIGUITY_FACTOR times as badly as the cell's own, and the patch has texture
- * (its grey-level variance at least MIN_TEXTURE_VARIANCE): a flat patch matches anywhere and
- * tells no motion from another.
+ * AMBIGUITY_FACTOR times as badly as the cell's own. A flat patch matches anywhere, so it is
+ * ambiguous too: the image cannot confirm its track over the other motion.
  * \return false as well when a patch leaves the image
  */
 DYNVO_EXPORTS bool trackIsAmbiguous(const FramePairColours& colours,
@@ -42,7 +41,5 @@ DYNVO_EXPORTS bool trackIsAmbiguous(const FramePairColours& colours,
 
 /// The other position matches within this factor of the track's own (ZSSD).
 constexpr float AMBIGUITY_FACTOR = 1.5f;
-/// Grey-level variance (levels^2) below which a patch has no texture to compare.
-constexpr float MIN_TEXTURE_VARIANCE = 20.0f;
 
 } // namespace dynvo
