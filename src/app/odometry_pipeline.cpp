@@ -657,7 +657,7 @@ struct OdometryPipeline::Impl {
       Eigen::Matrix4d::Identity();   ///< at the previous frame's depth instant
   double previous_depth_stamp = 0.0; ///< seconds
   double previous_stamp = 0.0;       ///< the previous frame's colour stamp (s)
-  /// H_pred of this frame: the last step, scaled down to the motion bound over step_dt
+  /// H_pred of this frame: the last measured step carried over its interval (predictStep())
   Eigen::Matrix4d T_curr_prev_predicted = Eigen::Matrix4d::Identity();
   Eigen::Matrix4d last_step =
       Eigen::Matrix4d::Identity();    ///< T_curr_prev of the last measured frame
