@@ -18,9 +18,9 @@ namespace {
 
 const char* const USAGE =
     "dynvo_synthesize -out DIR [-scenario NAME] [-frames N] [-seed S] [-clean] "
-    "[-threads N] [-width W -height H] | -composite TUM_DIR -scenario NAME -out DIR "
-    "[-frames N] [-seed S] [-camera C] [-fx -fy -cx -cy] [-distortion K] [-depth_scale "
-    "S] | -list";
+    "[-plain_objects] [-threads N] [-width W -height H] | -composite TUM_DIR -scenario "
+    "NAME -out DIR [-frames N] [-seed S] [-plain_objects] [-camera C] "
+    "[-fx -fy -cx -cy] [-distortion K] [-depth_scale S] | -list";
 
 /// \throws dynvo::app::UsageError when the options are out of range
 void
@@ -46,6 +46,7 @@ composite(const dynvo::app::Arguments& args)
   options.scenario = args.string("scenario", options.scenario);
   options.seed =
       static_cast<std::uint32_t>(args.integer("seed", options.seed, 0, 4294967295L));
+  options.plain_objects = args.has("plain_objects");
   dynvo::app::CompositeOptions composite;
   composite.recording = args.string("composite");
   composite.intrinsics = dynvo::app::intrinsicsFromArguments(args);
@@ -96,6 +97,8 @@ main(int argc, char** argv)
          "seed of textures and depth noise (default " + text(defaults.seed) + ")"},
         {"out", "DIR", "output folder; must not exist or be empty (required)"},
         {"clean", "", "exact depth (default: the Kinect v1 depth model)"},
+        {"plain_objects", "",
+         "the scenario's objects in one flat colour per face, without texture"},
         {"threads", "N",
          "worker threads (default: hardware count, " + text(hardware_threads) + ")"},
         {"width", "W", "image columns in px (default " + text(defaults.width) + ")"},
@@ -150,6 +153,7 @@ main(int argc, char** argv)
     options.seed =
         static_cast<std::uint32_t>(args.integer("seed", defaults.seed, 0, 4294967295L));
     options.noise = !args.has("clean");
+    options.plain_objects = args.has("plain_objects");
     options.width = static_cast<int>(args.integer("width", defaults.width, 8, 8192));
     options.height = static_cast<int>(args.integer("height", defaults.height, 8, 8192));
     const int threads =

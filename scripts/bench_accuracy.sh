@@ -5,7 +5,8 @@
 # `cmake --build build`. It synthesises the whole development set (every scenario of
 # `dynvo_synthesize -list`, realistic depth noise, one fixed seed), composites every object scenario into
 # each real recording of a static scene, tum_fr1_xyz_200 and tum_fr1_desk_fast (when dynvo_synthesize has
-# -composite), and adds the real recordings tum_fr1_xyz_200, tum_fr1_desk_fast and bonn_crowd_people
+# -composite), the scenarios of PLAIN_SCENARIOS once more with -plain_objects (one flat colour per face:
+# rows RECORDING+SCENARIO+plain_objects), and adds the real recordings tum_fr1_xyz_200, tum_fr1_desk_fast and bonn_crowd_people
 # (people walking: no truth masks, so its moving_share is the share of pixels labelled moving, not an
 # error) as they are, each with its own intrinsics. On each sequence it runs dynvo_odometry with
 # -labels_dir and -bench_reference cv_rgbd (OpenCV's RGB-D odometry over the whole image on the same
@@ -22,6 +23,7 @@ Usage: scripts/bench_accuracy.sh [-frames N] [-only NAME[,NAME...]] [-work DIR] 
                composites and the real recordings use min(N, the recording's frame count)
   -only LIST   comma-separated rows to run: a scenario name selects its synthetic sequence and
                its composites, RECORDING+NAME only that composite (RECORDING: $(commas $(composite_hosts))),
+               RECORDING+NAME+plain_objects its plain-object composite (NAME: $(commas "${PLAIN_SCENARIOS[@]}")),
                RECORDING the real recording as it is ($(commas "${REALS[@]}"))
                (default: everything)
   -work DIR    work folder (default \$DYNVO_BENCH_WORK or $BUILD/bench_accuracy); it must be
@@ -47,6 +49,8 @@ declare -A CAMERA=(
 # 1: a static scene, into which the object scenarios are composited and which is scored by
 # moving_share (should be near 0); 0: a scene with its own movers.
 declare -A STATIC_SCENE=([tum_fr1_xyz_200]=1 [tum_fr1_desk_fast]=1 [bonn_crowd_people]=0)
+# Composited once more with -plain_objects: a box Lucas-Kanade finds nothing to track inside.
+PLAIN_SCENARIOS=(moving_crossing)
 composite_hosts() { local r; for r in "${REALS[@]}"; do [ "${STATIC_SCENE[$r]}" = 0 ] || echo "$r"; done; }
 commas() { local list; list="$(printf '%s, ' "$@")"; printf '%s' "${list%, }"; }  # "a, b, c"
 
@@ -104,11 +108,14 @@ if [ -n "$ONLY" ]; then
     for host in $(composite_hosts); do
       base="${n#"$host"+}"
       if [ "$base" != "$n" ] && [ "${HAS_OBJECT[$base]:-0}" = 1 ]; then known=1; fi
+      if [ "$base" != "$n" ] && [[ " ${PLAIN_SCENARIOS[*]} " == *" ${base%+plain_objects} "* ]] &&
+         [ "${base%+plain_objects}" != "$base" ]; then known=1; fi
     done
     [ "$known" = 1 ] ||
       die "-only: '$n' is neither a scenario of dynvo_synthesize -list, a real recording" \
           "($(commas "${REALS[@]}")) nor RECORDING+SCENARIO with an object scenario and RECORDING" \
-          "one of $(commas $(composite_hosts))"
+          "one of $(commas $(composite_hosts)) (or RECORDING+SCENARIO+plain_objects, SCENARIO one of" \
+          "$(commas "${PLAIN_SCENARIOS[@]}"))"
     WANT[$n]=1
   done
 fi
@@ -256,6 +263,11 @@ for real in "${REALS[@]}"; do
     for s in "${SCENARIOS[@]}"; do
       if [ "${HAS_OBJECT[$s]}" = 1 ] && selected "$real+$s" "$s"; then want_composites+=("$s"); fi
     done
+    for s in "${PLAIN_SCENARIOS[@]}"; do
+      if [ "${HAS_OBJECT[$s]:-0}" = 1 ] && selected "$real+$s+plain_objects" "$s"; then
+        want_composites+=("$s+plain_objects")
+      fi
+    done
   fi
   want_real=0
   if selected "$real"; then want_real=1; fi
@@ -277,13 +289,16 @@ for real in "${REALS[@]}"; do
         "this dynvo_synthesize has no -composite yet (dynvo_synthesize -h does not list it)"
     want_composites=()
   fi
-  for s in "${want_composites[@]}"; do
-    label="$real+$s"
-    seq="$WORK/composite/$real/$s"
-    log="$WORK/runs/composite_${real}_$s.log"
-    say "$label: dynvo_synthesize -composite $real_dir -scenario $s -frames $rframes -seed $SEED ${camera[*]}"
-    if ! "$SYNTH" -composite "$real_dir" -scenario "$s" -out "$seq" -frames "$rframes" -seed "$SEED" \
-         "${camera[@]}" >"$log" 2>&1; then
+  for want in "${want_composites[@]}"; do
+    s="${want%+plain_objects}"
+    look=()
+    [ "$s" = "$want" ] || look=(-plain_objects)
+    label="$real+$want"
+    seq="$WORK/composite/$real/$want"
+    log="$WORK/runs/composite_${real}_$want.log"
+    say "$label: dynvo_synthesize -composite $real_dir -scenario $s ${look[*]} -frames $rframes -seed $SEED ${camera[*]}"
+    if ! "$SYNTH" -composite "$real_dir" -scenario "$s" "${look[@]}" -out "$seq" -frames "$rframes" \
+         -seed "$SEED" "${camera[@]}" >"$log" 2>&1; then
       failed_row "$label" "dynvo_synthesize -composite $real_dir -scenario $s" "$log"
       continue
     fi

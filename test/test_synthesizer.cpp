@@ -26,6 +26,7 @@
 #include <iomanip>
 #include <iterator>
 #include <map>
+#include <set>
 #include <sstream>
 
 namespace {
@@ -234,6 +235,39 @@ TEST(SceneSynthesizer, LabelsMarkExactlyTheMovingObjects)
   }
   EXPECT_GT(moving_views, 3);
   EXPECT_GT(still_views, 3);
+}
+
+TEST(SceneSynthesizer, PlainObjectsShowOneColourPerFace)
+{
+  // moving_crossing's box in view and moving. A box shows at most three faces, and a plain
+  // face is one albedo under one directional light: at most three colours on the object's
+  // pixels. The textured box shows many more, and the room stays as it was.
+  dynvo::SynthOptions options = smallOptions("moving_crossing");
+  options.noise = false;
+  const int k = 60;
+  const dynvo::SynthFrame textured = dynvo::SceneSynthesizer(options).render(k);
+  options.plain_objects = true;
+  const dynvo::SynthFrame plain = dynvo::SceneSynthesizer(options).render(k);
+  const auto colours = [](const dynvo::SynthFrame& frame) {
+    std::set<std::uint32_t> seen;
+    for (std::size_t i = 0; i < frame.labels.size(); ++i)
+      if (frame.labels[i] != 0)
+        seen.insert(std::uint32_t{frame.color.data[3 * i]} << 16 |
+                    std::uint32_t{frame.color.data[3 * i + 1]} << 8 |
+                    frame.color.data[3 * i + 2]);
+    return seen.size();
+  };
+  ASSERT_EQ(plain.labels, textured.labels); // the geometry does not depend on the look
+  const auto object_pixels =
+      plain.labels.size() - std::count(plain.labels.begin(), plain.labels.end(), 0);
+  ASSERT_GT(object_pixels, 200u);
+  EXPECT_LE(colours(plain), 3u);
+  EXPECT_GT(colours(textured), 100u);
+  for (std::size_t i = 0; i < plain.labels.size(); ++i)
+    if (plain.labels[i] == 0)
+      ASSERT_TRUE(std::equal(&plain.color.data[3 * i], &plain.color.data[3 * i + 3],
+                             &textured.color.data[3 * i]))
+          << "room pixel " << i;
 }
 
 /// A fronto-parallel wall at depth z, w x h samples.

@@ -27,6 +27,9 @@ constexpr double TWO_PI = 6.28318530717958647692;
 constexpr float AMBIENT = 0.45f;     ///< light reaching faces turned away from the lamp
 constexpr float DIFFUSE = 0.55f;     ///< Lambertian part at normal incidence
 constexpr float DARK_ALBEDO = 0.12f; ///< brightness of dark materials
+/// A plain face's share of its base colour: a textured face's mean (detail::surfaceAlbedo,
+/// 0.35 + 0.65 x 0.5 with a gain of 1 on average)
+constexpr float PLAIN_ALBEDO = 0.675f;
 constexpr float MIN_COSINE =
     0.25f; ///< footprint growth is capped at 4x at grazing angles
 constexpr int ROOM_SURFACES = 6;
@@ -50,11 +53,13 @@ SurfaceLook
 surfaceLook(std::uint32_t seed,
             int surface,
             const Eigen::Vector3d& normal_world,
-            bool dark = false)
+            bool dark = false,
+            bool plain = false)
 {
   SurfaceLook look;
   look.salt = detail::mix32(detail::mix32(seed) ^ static_cast<std::uint32_t>(surface));
   look.dark = dark;
+  look.plain = plain;
   const std::uint32_t colour = detail::mix32(look.salt);
   const float brightness = dark ? DARK_ALBEDO : 1.0f;
   for (int channel = 0; channel < 3; ++channel)
@@ -73,6 +78,7 @@ frameBox(const Eigen::Isometry3d& T_world_box,
          std::uint8_t label,
          int surface_base,
          bool dark,
+         bool plain,
          const Eigen::Isometry3d& T_world_camera,
          const CameraIntrinsics& intrinsics,
          const SynthOptions& options)
@@ -87,7 +93,7 @@ frameBox(const Eigen::Isometry3d& T_world_box,
     const Eigen::Vector3d normal_box =
         (face % 2 == 1 ? 1.0 : -1.0) * Eigen::Vector3d::Unit(face / 2);
     box.faces[face] = surfaceLook(options.seed, surface_base + face,
-                                  T_world_box.linear() * normal_box, dark);
+                                  T_world_box.linear() * normal_box, dark, plain);
   }
   // Rectangle of the projected corners; a corner near or behind the camera plane
   // makes the whole image a candidate.
@@ -255,7 +261,7 @@ SceneView::SceneView(const FrameScript& script,
       T_world_box.translation() = room.furniture[f].centre;
       boxes_.push_back(frameBox(T_world_box, room.furniture[f].half_extents, 0,
                                 FURNITURE_SURFACE_BASE + 6 * static_cast<int>(f),
-                                room.furniture[f].dark, script.T_world_camera,
+                                room.furniture[f].dark, false, script.T_world_camera,
                                 intrinsics, options));
     }
     for (int face = 0; face < ROOM_SURFACES; ++face) // normals point into the room
@@ -267,7 +273,8 @@ SceneView::SceneView(const FrameScript& script,
     boxes_.push_back(frameBox(object.T_world_object, object.half_extents,
                               object.moving ? static_cast<std::uint8_t>(object.id) : 0,
                               OBJECT_SURFACE_BASE + 6 * object.id, false,
-                              script.T_world_camera, intrinsics, options));
+                              options.plain_objects, script.T_world_camera, intrinsics,
+                              options));
   R_ = script.T_world_camera.linear().cast<float>();
   o_ = script.T_world_camera.translation().cast<float>();
   room_min_ = room.min_corner.cast<float>();
@@ -354,8 +361,12 @@ SceneView::cast(float u, float v, PixelHit& out) const
       t_best * ray_norm /
       (static_cast<float>(std::min(K.fx, K.fy)) * std::max(cosine, MIN_COSINE));
   float albedo[3];
-  detail::surfaceAlbedo(hit[(axis + 1) % 3], hit[(axis + 2) % 3], look->base,
-                        look->salt, footprint, albedo);
+  if (look->plain)
+    for (int channel = 0; channel < 3; ++channel)
+      albedo[channel] = look->base[channel] * PLAIN_ALBEDO;
+  else
+    detail::surfaceAlbedo(hit[(axis + 1) % 3], hit[(axis + 2) % 3], look->base,
+                          look->salt, footprint, albedo);
   for (int channel = 0; channel < 3; ++channel)
     out.rgb[channel] = albedo[channel] * look->shade * 255.0f;
   out.surface = {t_best, cosine, look->dark};

@@ -29,7 +29,8 @@ struct SurfaceLook {
   std::uint32_t salt;
   float base[3];
   float shade;
-  bool dark; ///< dark or shiny: no structured-light return (DepthSensorModel)
+  bool dark;  ///< dark or shiny: no structured-light return (DepthSensorModel)
+  bool plain; ///< one flat colour (SynthOptions::plain_objects), no texture
 };
 
 /// An oriented box as seen from one camera pose.

@@ -55,6 +55,9 @@ struct DYNVO_EXPORTS SynthOptions {
   bool noise = true;      ///< DepthSensorModel on; off = exact depth everywhere
   /// Motion blur of the scenarios with an exposure; off = colour of the frame's instant
   bool motion_blur = true;
+  /// The scripted objects in one flat colour per face, without texture (the room keeps
+  /// its texture): a plain box, on which Lucas-Kanade has nothing to track
+  bool plain_objects = false;
   /// Intrinsics at 640x480 (scaled with width/height); the "default" preset.
   CameraIntrinsics intrinsics;
 
@@ -77,6 +80,8 @@ struct DYNVO_EXPORTS SynthOptions {
  * the hit point, so the image is band-limited and sub-pixel tracking stays accurate.
  * Shading is Lambertian under one fixed directional light plus ambient light, so a
  * surface looks the same from every viewpoint (no shadows, no specular highlights).
+ * SynthOptions::plain_objects paints each face of the scripted objects in its base colour
+ * times the textures' mean factor instead: one flat colour per face, no image noise.
  *
  * Motion: the camera follows sums of sinusoids (about 0.1-0.3 m/s and up to about
  * 4 deg/s; circling_bobbing circles its box at up to 9 deg/s) in the moving-camera
