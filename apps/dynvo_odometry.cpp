@@ -156,7 +156,8 @@ main(int argc, char** argv)
           renderer.add(frame, result, outputs.trajectory());
           if (reference) // timed on its own, after the pipeline's frame
             reference->add(frame);
-        });
+        },
+        args.has("read_ahead"));
     renderer.finish(outputs.trajectory(), groundtruth);
     end.report.printSummary(
         groundtruth.empty()

@@ -47,7 +47,8 @@ main(int argc, char** argv)
                                   {{"-out_dir", args.string("out_dir"), true}});
     dynvo::app::RunOutputs outputs(paths);
     // Whatever stops the run, the labels and objects of the frames done are kept.
-    const auto end = dynvo::app::runPipeline(options, max_frames, *source, outputs);
+    const auto end = dynvo::app::runPipeline(options, max_frames, *source, outputs, {},
+                                             args.has("read_ahead"));
     end.report.printSummary();
     return end.loop.error.empty() ? 0 : 1;
   });

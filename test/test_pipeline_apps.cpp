@@ -4,7 +4,10 @@
 // flags mean the same in dynvo_odometry, dynvo_segment and dynvo_scene_flow.
 #include <dynvo/app/pipeline_args.h>
 #include <dynvo/app/pipeline_config.h>
+#include <dynvo/io/frame_source.h>
 #include <dynvo/io/label_io.h>
+
+#include <pcl/exceptions.h>
 
 #include <gtest/gtest.h>
 
@@ -13,6 +16,7 @@
 #include "support/temp_dir.h"
 
 #include <algorithm>
+#include <atomic>
 #include <filesystem>
 #include <map>
 #include <sstream>
@@ -236,6 +240,72 @@ TEST(PipelineFlags, ValuesOutOfRangeAreUsageErrors)
             "-backend must be flow|cv_rgbd|icp|gicp|direct, got 'lm'");
   EXPECT_EQ(message({"-window_size", "x"}),
             "option '-window_size' expects an integer, got 'x'");
+}
+
+/// Frames named frame_0, frame_1, ... of which `frames` exist; reading frame `broken` throws.
+class NumberedSource : public dynvo::FrameSource {
+public:
+  NumberedSource(int frames, int broken)
+      : frames_(frames)
+      , broken_(broken)
+  {
+  }
+
+  bool next(dynvo::Frame& frame) override
+  {
+    const int k = reads_++;
+    if (k == broken_)
+      throw pcl::IOException("frame_" + std::to_string(k) + ": cannot be read");
+    if (k >= frames_)
+      return false;
+    frame.name = "frame_" + std::to_string(k);
+    frame.timestamp = k;
+    return true;
+  }
+
+  std::size_t size() const override { return static_cast<std::size_t>(frames_); }
+
+  int reads() const { return reads_; }
+
+private:
+  int frames_, broken_;
+  std::atomic<int> reads_{0};
+};
+
+TEST(FrameLoop, ReadingAheadChangesNothingButWhenFramesAreRead)
+{
+  // The same frames in the same order, the same stop on a broken file and at max_frames,
+  // and no read beyond max_frames (a frame not asked for may be missing or broken).
+  for (const bool ahead : {false, true}) {
+    SCOPED_TRACE(ahead ? "read ahead" : "read in turn");
+    const auto run = [ahead](NumberedSource& source, std::size_t max_frames) {
+      std::vector<std::string> seen;
+      const dynvo::app::FrameLoopEnd end = dynvo::app::processFrames(
+          source, max_frames,
+          [&seen](const dynvo::Frame& frame) {
+            seen.push_back(frame.name);
+          },
+          ahead);
+      EXPECT_EQ(end.frames, seen.size());
+      return std::make_pair(seen, end.error);
+    };
+    NumberedSource whole(5, -1);
+    const auto [all, no_error] = run(whole, 0);
+    EXPECT_EQ(all, (std::vector<std::string>{"frame_0", "frame_1", "frame_2", "frame_3",
+                                             "frame_4"}));
+    EXPECT_EQ(no_error, "");
+
+    NumberedSource broken(5, 3);
+    const auto [before, error] = run(broken, 0);
+    EXPECT_EQ(before.size(), 3u);
+    EXPECT_NE(error.find("frame_3: cannot be read"), std::string::npos) << error;
+
+    NumberedSource limited(5, 3);
+    const auto [first, limit_error] = run(limited, 3);
+    EXPECT_EQ(first.size(), 3u);
+    EXPECT_EQ(limit_error, "");
+    EXPECT_EQ(limited.reads(), 3);
+  }
 }
 
 } // namespace

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <dynvo/app/frame_source_args.h>
+#include <dynvo/common/parallel.h>
 #include <dynvo/io/oni_file_source.h>
 #include <dynvo/io/pcd_sequence_source.h>
 #include <dynvo/io/tum_folder_source.h>
@@ -8,7 +9,9 @@
 
 #include <cstdint>
 #include <algorithm>
+#include <future>
 #include <limits>
+#include <memory>
 
 namespace dynvo::app {
 
@@ -97,15 +100,40 @@ openFrameSource(const Arguments& args)
 FrameLoopEnd
 processFrames(FrameSource& source,
               std::size_t max_frames,
-              const std::function<void(const Frame&)>& process)
+              const std::function<void(const Frame&)>& process,
+              bool read_ahead)
 {
   FrameLoopEnd end;
   std::string where; // the frame in hand, once it has been read
+  const auto wanted = [max_frames](std::size_t k) {
+    return max_frames == 0 || k < max_frames;
+  };
+  // The next frame, none at the end of the recording.
+  const auto read = [&source] {
+    auto frame = std::make_unique<Frame>();
+    if (!source.next(*frame))
+      frame.reset();
+    return frame;
+  };
+  // Last, so that a read still running when the loop stops ends before anything it uses.
+  std::unique_ptr<TaskThread> reader;
+  if (read_ahead)
+    reader = std::make_unique<TaskThread>();
   try {
-    Frame frame;
-    while ((max_frames == 0 || end.frames < max_frames) && source.next(frame)) {
-      where = frame.name + ": ";
-      process(frame);
+    const auto readNext = [&] {
+      return reader ? reader->run(read) : std::async(std::launch::deferred, read);
+    };
+    std::future<std::unique_ptr<Frame>> next;
+    if (wanted(0))
+      next = readNext();
+    while (next.valid()) {
+      const std::unique_ptr<Frame> frame = next.get();
+      if (!frame)
+        break;
+      if (wanted(end.frames + 1))
+        next = readNext();
+      where = frame->name + ": ";
+      process(*frame);
       where.clear();
       ++end.frames;
     }

@@ -136,6 +136,9 @@ appOptions(PipelineStages stages, std::vector<Option> own)
       options.push_back(optionOf(flag));
   if (stages == PipelineStages::all) {
     options.push_back({"max_frames", "N", "stop after N frames (default 0 = all)"});
+    options.push_back({"read_ahead", "",
+                       "read the next frame on a thread of its own: a shorter run, "
+                       "longer frames on two cores"});
     options.push_back(
         {"objects", "FILE",
          "write 'timestamp id n_pixels tx ty tz qx qy qz qw' per object"});
@@ -253,20 +256,24 @@ runPipeline(const PipelineOptions& options,
             std::size_t max_frames,
             FrameSource& source,
             RunOutputs& outputs,
-            const std::function<void(const Frame&, const FrameResult&)>& on_result)
+            const std::function<void(const Frame&, const FrameResult&)>& on_result,
+            bool read_ahead)
 {
   OdometryPipeline pipeline(options);
   PipelineRunEnd end{
       {},
       RunReport(max_frames > 0 ? std::min(max_frames, source.size()) : source.size())};
-  end.loop = processFrames(source, max_frames, [&](const Frame& frame) {
-    const auto& result =
-        pipeline.process(frame.cloud, frame.timestamp, frame.depth_timestamp);
-    outputs.add(frame, result);
-    if (on_result)
-      on_result(frame, result);
-    end.report.add(result);
-  });
+  end.loop = processFrames(
+      source, max_frames,
+      [&](const Frame& frame) {
+        const auto& result =
+            pipeline.process(frame.cloud, frame.timestamp, frame.depth_timestamp);
+        outputs.add(frame, result);
+        if (on_result)
+          on_result(frame, result);
+        end.report.add(result);
+      },
+      read_ahead);
   outputs.finish();
   return end;
 }

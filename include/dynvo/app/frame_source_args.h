@@ -38,10 +38,16 @@ struct FrameLoopEnd {
  * pcl::console::print_error as "Error: <frame file>: <why> (stopped after N frames ...)",
  * so that the app still writes what was computed and then exits 1.
  * \param[in] max_frames frames to process at most (0 = all)
+ * \param[in] read_ahead read the next frame on a thread of its own while process() runs.
+ * Reading (decoding, undistortion, the cloud) is a third to a half of a TUM run's work, so
+ * the run ends sooner, but on two cores the reader takes time from process(). The frames,
+ * their order and what stops the run are the same: a frame beyond max_frames is never
+ * read, and an error reading frame k + 1 stops the run after frame k.
  */
 DYNVO_EXPORTS FrameLoopEnd
 processFrames(FrameSource& source,
               std::size_t max_frames,
-              const std::function<void(const Frame&)>& process);
+              const std::function<void(const Frame&)>& process,
+              bool read_ahead = false);
 
 } // namespace dynvo::app

@@ -93,15 +93,17 @@ struct PipelineRunEnd {
 /** \brief Runs OdometryPipeline(options) over the source, at most max_frames frames (0 =
  * all; see maxFramesFromArguments()). Each result goes to outputs, then to on_result (may be empty), then to the
  * report. Whatever stops the run (see processFrames()), outputs.finish() then writes what
- * was computed.
+ * was computed. read_ahead (-read_ahead): processFrames() reads the next frame beside the
+ * pipeline; the results are the same.
  * \throws std::invalid_argument when the options are invalid
  * \throws pcl::IOException when outputs.finish() cannot write a file
  */
-DYNVO_EXPORTS PipelineRunEnd runPipeline(
-    const PipelineOptions& options,
-    std::size_t max_frames,
-    FrameSource& source,
-    RunOutputs& outputs,
-    const std::function<void(const Frame&, const FrameResult&)>& on_result = {});
+DYNVO_EXPORTS PipelineRunEnd
+runPipeline(const PipelineOptions& options,
+            std::size_t max_frames,
+            FrameSource& source,
+            RunOutputs& outputs,
+            const std::function<void(const Frame&, const FrameResult&)>& on_result = {},
+            bool read_ahead = false);
 
 } // namespace dynvo::app
