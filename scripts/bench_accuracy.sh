@@ -108,8 +108,9 @@ if [ -n "$ONLY" ]; then
     for host in $(composite_hosts); do
       base="${n#"$host"+}"
       if [ "$base" != "$n" ] && [ "${HAS_OBJECT[$base]:-0}" = 1 ]; then known=1; fi
-      if [ "$base" != "$n" ] && [[ " ${PLAIN_SCENARIOS[*]} " == *" ${base%+plain_objects} "* ]] &&
-         [ "${base%+plain_objects}" != "$base" ]; then known=1; fi
+      plain="${base%+plain_objects}"
+      if [ "$base" != "$n" ] && [ "$plain" != "$base" ] &&
+         [[ " ${PLAIN_SCENARIOS[*]} " == *" $plain "* ]]; then known=1; fi
     done
     [ "$known" = 1 ] ||
       die "-only: '$n' is neither a scenario of dynvo_synthesize -list, a real recording" \
@@ -299,7 +300,7 @@ for real in "${REALS[@]}"; do
     say "$label: dynvo_synthesize -composite $real_dir -scenario $s ${look[*]} -frames $rframes -seed $SEED ${camera[*]}"
     if ! "$SYNTH" -composite "$real_dir" -scenario "$s" "${look[@]}" -out "$seq" -frames "$rframes" \
          -seed "$SEED" "${camera[@]}" >"$log" 2>&1; then
-      failed_row "$label" "dynvo_synthesize -composite $real_dir -scenario $s" "$log"
+      failed_row "$label" "dynvo_synthesize -composite $real_dir -scenario $s ${look[*]}" "$log"
       continue
     fi
     sed 's/^/    /' "$log"

@@ -110,6 +110,13 @@ detailWeight(float lattice, float footprint)
   return std::clamp((lattice / footprint - 1.5f) / 1.5f, 0.0f, 1.0f);
 }
 
+/// A textured face's albedo is its base colour times ALBEDO_FLOOR + ALBEDO_SPAN x (colour
+/// patches in [0, 1], 0.5 on average) times a luminance gain (1 on average).
+constexpr float ALBEDO_FLOOR = 0.35f;
+constexpr float ALBEDO_SPAN = 0.65f;
+/// The base colour's mean share over a textured face: a plain face's share.
+constexpr float MEAN_ALBEDO = ALBEDO_FLOOR + 0.5f * ALBEDO_SPAN;
+
 /** \brief Albedo of a textured surface at face coordinates (x, y) in metres.
  * \param[in] base the surface's base colour (linear, [0, 1])
  * \param[in] salt the surface's texture seed
@@ -149,8 +156,8 @@ surfaceAlbedo(float x,
   for (int channel = 0; channel < 3; ++channel) {
     const float patches = 0.6f * (0.5f + w_coarse * (coarse[channel] - 0.5f)) +
                           0.4f * (0.5f + w_mid * (mid[channel] - 0.5f));
-    rgb[channel] =
-        std::clamp(base[channel] * (0.35f + 0.65f * patches) * gain, 0.0f, 1.0f);
+    rgb[channel] = std::clamp(
+        base[channel] * (ALBEDO_FLOOR + ALBEDO_SPAN * patches) * gain, 0.0f, 1.0f);
   }
 }
 

@@ -27,9 +27,6 @@ constexpr double TWO_PI = 6.28318530717958647692;
 constexpr float AMBIENT = 0.45f;     ///< light reaching faces turned away from the lamp
 constexpr float DIFFUSE = 0.55f;     ///< Lambertian part at normal incidence
 constexpr float DARK_ALBEDO = 0.12f; ///< brightness of dark materials
-/// A plain face's share of its base colour: a textured face's mean (detail::surfaceAlbedo,
-/// 0.35 + 0.65 x 0.5 with a gain of 1 on average)
-constexpr float PLAIN_ALBEDO = 0.675f;
 constexpr float MIN_COSINE =
     0.25f; ///< footprint growth is capped at 4x at grazing angles
 constexpr int ROOM_SURFACES = 6;
@@ -363,7 +360,7 @@ SceneView::cast(float u, float v, PixelHit& out) const
   float albedo[3];
   if (look->plain)
     for (int channel = 0; channel < 3; ++channel)
-      albedo[channel] = look->base[channel] * PLAIN_ALBEDO;
+      albedo[channel] = look->base[channel] * detail::MEAN_ALBEDO;
   else
     detail::surfaceAlbedo(hit[(axis + 1) % 3], hit[(axis + 2) % 3], look->base,
                           look->salt, footprint, albedo);
