@@ -2,12 +2,12 @@
 // Two-frame rigid motion segmentation (docs/algorithm.md §3).
 #include <dynvo/motion_segmentation/spatial_segmentation.h>
 
-#include <dynvo/common/parallel.h>
 #include <dynvo/common/rigid_fit.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <functional>
 #include <limits>
 #include <numeric>
 #include <stdexcept>
@@ -55,25 +55,52 @@ collectInliers(const std::vector<float>& errors,
 
 } // namespace
 
-void
-SpatialSegmenter::setNumberOfThreads(unsigned threads)
-{
-  if (threads == 0)
-    throw std::invalid_argument(
-        "[dynvo::SpatialSegmenter::setNumberOfThreads] need at least 1 thread, got 0");
-  threads_ = threads;
-}
-
 std::vector<int>
-dbscan(const std::vector<double>& distances, int count, double epsilon, int min_points)
+dbscan(int count, int min_points, const std::function<bool(int, int)>& neighbours)
 {
   constexpr int UNASSIGNED = -1;
   std::vector<int> cluster(static_cast<std::size_t>(count), UNASSIGNED);
+  if (min_points <= 1) {
+    // Connected components: each pair joins two trees of a union-find forest unless one
+    // tree already holds both, whose test is then not needed (on a real frame most pairs
+    // of the 20 hypotheses describe the background and fall into one tree early).
+    std::vector<int> parent(static_cast<std::size_t>(count));
+    std::iota(parent.begin(), parent.end(), 0);
+    const auto root = [&](int i) {
+      while (parent[i] != i)
+        i = parent[i] = parent[parent[i]];
+      return i;
+    };
+    for (int i = 0; i < count; ++i)
+      for (int j = i + 1; j < count; ++j) {
+        const int ri = root(i), rj = root(j);
+        // Each root stays its tree's smallest item.
+        if (ri != rj && neighbours(i, j))
+          parent[std::max(ri, rj)] = std::min(ri, rj);
+      }
+    int next_cluster = 0;
+    for (int i = 0; i < count; ++i) {
+      const int r = root(i);
+      cluster[i] = r == i ? next_cluster++ : cluster[r];
+    }
+    return cluster;
+  }
+  // Each pair tested once, kept for the other item's neighbourhood.
+  enum : char { UNKNOWN, NEAR, FAR };
+  std::vector<char> tested(static_cast<std::size_t>(count) * count, UNKNOWN);
+  const auto near = [&](int i, int j) {
+    if (i == j)
+      return true;
+    char& t = tested[static_cast<std::size_t>(std::min(i, j)) * count + std::max(i, j)];
+    if (t == UNKNOWN)
+      t = neighbours(std::min(i, j), std::max(i, j)) ? NEAR : FAR;
+    return t == NEAR;
+  };
   std::vector<char> visited(static_cast<std::size_t>(count), 0);
-  const auto neighbours = [&](int i) {
+  const auto neighbourhood = [&](int i) {
     std::vector<int> result;
     for (int j = 0; j < count; ++j)
-      if (distances[static_cast<std::size_t>(i) * count + j] <= epsilon)
+      if (near(i, j))
         result.push_back(j);
     return result;
   };
@@ -82,7 +109,7 @@ dbscan(const std::vector<double>& distances, int count, double epsilon, int min_
     if (visited[i])
       continue;
     visited[i] = 1;
-    std::vector<int> queue = neighbours(i);
+    std::vector<int> queue = neighbourhood(i);
     if (static_cast<int>(queue.size()) < min_points)
       continue; // noise unless a later core point reaches it
     const int id = next_cluster++;
@@ -91,7 +118,7 @@ dbscan(const std::vector<double>& distances, int count, double epsilon, int min_
       const int j = queue[q];
       if (!visited[j]) {
         visited[j] = 1;
-        const std::vector<int> more = neighbours(j);
+        const std::vector<int> more = neighbourhood(j);
         if (static_cast<int>(more.size()) >= min_points)
           queue.insert(queue.end(), more.begin(), more.end());
       }
@@ -107,7 +134,8 @@ ResidualThresholds::of(const RigidMotionSegmentationParameters& params)
 {
   if (params.residual_model == ResidualModel::paper)
     return {params.inlier_threshold, params.entropy_lambda, params.dbscan_epsilon};
-  return {params.inlier_chi2, params.sensor_entropy_lambda, params.sensor_dbscan_epsilon};
+  return {params.inlier_chi2, params.sensor_entropy_lambda,
+          params.sensor_dbscan_epsilon};
 }
 
 double
@@ -227,8 +255,7 @@ SpatialSegmenter::clusterHypotheses(
     const RigidMotionSegmentationParameters& params) const
 {
   const int h = static_cast<int>(accepted_.size());
-  std::vector<double> distances(static_cast<std::size_t>(h) * h, 0.0);
-  // Converted once for the h (h - 1) / 2 pairs (exact: every float is a double).
+  // Converted once for all pairs (exact: every float is a double).
   std::vector<Eigen::Vector3d> a(a_.size());
   std::transform(a_.begin(), a_.end(), a.begin(), [](const Eigen::Vector3f& p) {
     return p.cast<double>();
@@ -237,22 +264,11 @@ SpatialSegmenter::clusterHypotheses(
   std::transform(w_.begin(), w_.end(), w.begin(), [](const Eigen::Matrix3f& m) {
     return m.cast<double>();
   });
-  // The h (h - 1) / 2 pairs, each a pass over two inlier lists (0.4 ms of a real frame), in
-  // stripes of pairs: every pair is computed alone, so the distances do not depend on them.
-  std::vector<std::pair<int, int>> pairs;
-  pairs.reserve(static_cast<std::size_t>(h) * (h - 1) / 2);
-  for (int i = 0; i < h; ++i)
-    for (int j = i + 1; j < h; ++j)
-      pairs.emplace_back(i, j);
-  forEachStripe(pairs.size(), threads_, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t p = begin; p < end; ++p) {
-      const auto [i, j] = pairs[p];
-      const double d = motionFieldDistance(accepted_[i], accepted_[j], a, w);
-      distances[static_cast<std::size_t>(i) * h + j] = d;
-      distances[static_cast<std::size_t>(j) * h + i] = d;
-    }
+  // Each pair is a pass over two inlier lists (about 2 us on a real frame): DBSCAN asks
+  // only for the pairs it needs.
+  return dbscan(h, params.dbscan_min_points, [&](int i, int j) {
+    return motionFieldDistance(accepted_[i], accepted_[j], a, w) <= th_.epsilon;
   });
-  return dbscan(distances, h, th_.epsilon, params.dbscan_min_points);
 }
 
 void
@@ -383,9 +399,8 @@ SpatialSegmenter::segment(const GridFlowData& grid,
     double sum = 0.0;
     for (std::size_t k = 0; k < n; ++k) {
       min_errors_[k] = std::min(min_errors_[k], errors_[k]);
-      entropy_[k] =
-          1.0 - std::exp(-static_cast<double>(params.entropy_delta) -
-                         static_cast<double>(th_.lambda) * min_errors_[k]);
+      entropy_[k] = 1.0 - std::exp(-static_cast<double>(params.entropy_delta) -
+                                   static_cast<double>(th_.lambda) * min_errors_[k]);
       sum += entropy_[k];
     }
     accepted_.push_back(hypothesis);

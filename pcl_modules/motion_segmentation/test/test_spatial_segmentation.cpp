@@ -8,6 +8,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <functional>
+#include <numeric>
+#include <random>
 #include <vector>
 
 namespace {
@@ -199,34 +203,81 @@ TEST(SpatialSegmentation, MotionFieldDistanceOfTwoTranslations)
   EXPECT_NEAR(dynvo::motionFieldDistance(x, y, a, {}), std::sqrt(1e-4 / 2.0), 1e-6);
 }
 
-/// Distance matrix of items on a line at the given positions.
-std::vector<double>
-lineDistances(const std::vector<double>& positions)
-{
-  const std::size_t n = positions.size();
-  std::vector<double> d(n * n);
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t j = 0; j < n; ++j)
-      d[i * n + j] = std::abs(positions[i] - positions[j]);
-  return d;
-}
+/// The neighbour test of items on a line at the given positions (|x_i - x_j| <= epsilon),
+/// counting its calls.
+struct LineNeighbours {
+  std::vector<double> positions;
+  double epsilon;
+  int calls = 0;
+  std::function<bool(int, int)> test()
+  {
+    return [this](int i, int j) {
+      ++calls;
+      return std::abs(positions[i] - positions[j]) <= epsilon;
+    };
+  }
+};
 
 TEST(Dbscan, MinPointsOneGivesConnectedComponents)
 {
   // Chain 0-1-2 (steps of 4 <= eps 5), isolated 3, pair 4-5; 0 and 2 are 8 apart but linked.
-  const std::vector<double> positions = {0, 4, 8, 30, 60, 63};
-  const std::vector<int> clusters = dynvo::dbscan(lineDistances(positions), 6, 5.0, 1);
+  LineNeighbours line{{0, 4, 8, 30, 60, 63}, 5.0};
+  const std::vector<int> clusters = dynvo::dbscan(6, 1, line.test());
   EXPECT_EQ(clusters, (std::vector<int>{0, 0, 0, 1, 2, 2}));
+}
+
+TEST(Dbscan, MinPointsOneAsksNoPairAlreadyJoined)
+{
+  // Five items within eps of each other: 0-1, 0-2, 0-3, 0-4 join all of them, and none of
+  // the six pairs among 1-4 is asked.
+  LineNeighbours line{{0, 1, 2, 3, 4}, 5.0};
+  EXPECT_EQ(dynvo::dbscan(5, 1, line.test()), (std::vector<int>(5, 0)));
+  EXPECT_EQ(line.calls, 4);
+}
+
+TEST(Dbscan, MinPointsOneFindsTheComponentsOfRandomGraphs)
+{
+  // The union-find's components against label propagation (each item takes the smallest
+  // label among its neighbours' until nothing changes) on random graphs of 2-21 items.
+  std::mt19937 rng(7);
+  for (int round = 0; round < 50; ++round) {
+    const int n = 2 + static_cast<int>(rng() % 20);
+    std::vector<char> edge(static_cast<std::size_t>(n) * n, 0);
+    for (int i = 0; i < n; ++i)
+      for (int j = i + 1; j < n; ++j)
+        edge[i * n + j] = edge[j * n + i] = rng() % 7 == 0;
+    std::vector<int> label(n);
+    std::iota(label.begin(), label.end(), 0);
+    for (bool changed = true; changed;) {
+      changed = false;
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j)
+          if (edge[i * n + j] && label[j] < label[i]) {
+            label[i] = label[j];
+            changed = true;
+          }
+    }
+    std::vector<int> expected(n), id(n, -1);
+    int next = 0;
+    for (int i = 0; i < n; ++i)
+      expected[i] = id[label[i]] < 0 ? (id[label[i]] = next++) : id[label[i]];
+    EXPECT_EQ(dynvo::dbscan(n, 1,
+                            [&](int i, int j) {
+                              return edge[i * n + j] != 0;
+                            }),
+              expected);
+  }
 }
 
 TEST(Dbscan, MinPointsMarksNoiseAndBorderPoints)
 {
   // With min_points 3, only item 1 (neighbours 0, 1, 2) is core; 0 and 2 are border points
-  // of its cluster; 3, 4 and 5 are noise.
-  const std::vector<double> positions = {0, 4, 8, 30, 60, 63};
-  const std::vector<int> clusters = dynvo::dbscan(lineDistances(positions), 6, 5.0, 3);
+  // of its cluster; 3, 4 and 5 are noise. Each of the 15 pairs is tested once.
+  LineNeighbours line{{0, 4, 8, 30, 60, 63}, 5.0};
+  const std::vector<int> clusters = dynvo::dbscan(6, 3, line.test());
   EXPECT_EQ(clusters, (std::vector<int>{0, 0, 0, -1, -1, -1}));
-  EXPECT_TRUE(dynvo::dbscan({}, 0, 1.0, 1).empty());
+  EXPECT_EQ(line.calls, 15);
+  EXPECT_TRUE(dynvo::dbscan(0, 1, line.test()).empty());
 }
 
 } // namespace

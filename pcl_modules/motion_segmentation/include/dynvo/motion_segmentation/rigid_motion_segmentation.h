@@ -209,9 +209,9 @@ public:
 
   const CameraIntrinsics& getCameraIntrinsics() const { return intrinsics_; }
 
-  /** \brief Threads (default 1) for the hypotheses' pairwise distances and the per-pixel
-   * index extraction (dynvo::forEachStripe); the other per-cell loops take microseconds and
-   * stay on the caller's thread. Results are identical for any count.
+  /** \brief Threads (default 1) for the per-pixel index extraction (dynvo::forEachStripe); the
+   * per-cell loops take microseconds and stay on the caller's thread. Results are identical
+   * for any count.
    * \throws std::invalid_argument on 0
    */
   void setNumberOfThreads(unsigned threads);

@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <functional>
 #include <random>
 #include <vector>
 
@@ -36,19 +37,22 @@ struct SpatialSegmentationResult {
   int segmentCount() const { return static_cast<int>(sizes.size()); }
 };
 
-/** \brief DBSCAN over a precomputed distance matrix (Yarpiz MATLAB DBSCAN semantics).
+/** \brief DBSCAN over a neighbour test (Yarpiz MATLAB DBSCAN semantics).
  *
  * The neighbourhood of an item includes the item itself; an item is a core point when its
- * neighbourhood (distance <= epsilon) holds at least min_points items. With min_points = 1
- * this is single-linkage connected components and no item is noise.
- * \param[in] distances count x count symmetric matrix, row-major
+ * neighbourhood holds at least min_points items. With min_points = 1 every item is a core
+ * point, the clusters are the connected components of the neighbour graph and no item is
+ * noise: pairs are joined in order, and a pair already in one cluster is not tested.
  * \param[in] count number of items
- * \param[in] epsilon neighbourhood radius (same unit as distances)
  * \param[in] min_points core-point size (>= 1)
- * \return cluster id per item (0, 1, ... in order of discovery), -1 for noise
+ * \param[in] neighbours symmetric test of two items i < j (distance <= epsilon), called at
+ *            most once per pair
+ * \return cluster id per item (0, 1, ... in order of discovery; with min_points = 1, of each
+ *         cluster's smallest item), -1 for noise
  */
-DYNVO_EXPORTS std::vector<int>
-dbscan(const std::vector<double>& distances, int count, double epsilon, int min_points);
+DYNVO_EXPORTS std::vector<int> dbscan(int count,
+                                      int min_points,
+                                      const std::function<bool(int, int)>& neighbours);
 
 /** \brief Motion-field distance of two hypotheses (docs/algorithm.md §3.5):
  * sqrt(mean over i in I_x u I_y of d_i^T W_i d_i), d_i = (R_x - R_y) a_i + (t_x - t_y);
@@ -80,15 +84,11 @@ struct DYNVO_EXPORTS ResidualThresholds {
  * accepted when every sample point is an inlier, up to refine_iterations inlier/refit rounds,
  * the three stopping rules, DBSCAN with the motion-field distance, and labelling with
  * small-segment removal. The scratch buffers are kept between calls. Deterministic: the
- * result depends on the input and params only, not on the thread count: the per-cell loops
- * (a few microseconds each) run on the caller's thread, only the hypotheses' pairwise
- * distances go in stripes (NOTES.md, decision 11).
+ * result depends on the input and params only. One thread: each loop takes microseconds, and
+ * DBSCAN computes only the distances it needs (NOTES.md, decision 11).
  */
 class DYNVO_EXPORTS SpatialSegmenter {
 public:
-  /// Threads (default 1) for the hypotheses' pairwise distances. \throws std::invalid_argument on 0
-  void setNumberOfThreads(unsigned threads);
-
   /** \param[in] grid scene flow of the frame pair, with information for the sensor model
    *  \param[in] params validated parameters
    *  \param[out] result labels per cell and one motion per segment (all 0 and no segment
@@ -137,7 +137,6 @@ private:
   using Draw = std::discrete_distribution<int>;
   std::mt19937 rng_; ///< sampling RNG
   Draw draw_;        ///< seed distribution S_k / sum S, rebuilt on acceptance
-  unsigned threads_ = 1; ///< setNumberOfThreads()
 };
 
 } // namespace dynvo

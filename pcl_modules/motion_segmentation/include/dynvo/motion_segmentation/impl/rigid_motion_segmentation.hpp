@@ -69,7 +69,6 @@ RigidMotionSegmentation<PointT>::setNumberOfThreads(unsigned threads)
     throw std::invalid_argument("[dynvo::" + getClassName() +
                                 "::setNumberOfThreads] need at least 1 thread, got 0");
   threads_ = threads;
-  segmenter_.setNumberOfThreads(threads);
 }
 
 template <typename PointT>
