@@ -13,31 +13,6 @@
 namespace dynvo {
 
 void
-RigidFitAccumulator::add(const Eigen::Vector3d& source,
-                         const Eigen::Vector3d& target,
-                         double weight)
-{
-  if (!source.allFinite() || !target.allFinite() || !std::isfinite(weight) ||
-      weight < 0.0)
-    throw std::invalid_argument("[dynvo::RigidFitAccumulator::add] points must be "
-                                "finite and the weight finite and "
-                                ">= 0");
-  if (weight == 0.0)
-    return;
-  if (count_ == 0) {
-    source_origin_ = source;
-    target_origin_ = target;
-  }
-  const Eigen::Vector3d s = source - source_origin_;
-  const Eigen::Vector3d q = target - target_origin_;
-  ++count_;
-  weight_sum_ += weight;
-  source_sum_ += weight * s;
-  target_sum_ += weight * q;
-  cross_sum_.noalias() += (weight * q) * s.transpose();
-}
-
-void
 RigidFitAccumulator::clear()
 {
   *this = RigidFitAccumulator();

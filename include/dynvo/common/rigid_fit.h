@@ -6,7 +6,9 @@
 
 #include <Eigen/Core>
 
+#include <cmath>
 #include <cstddef>
+#include <stdexcept>
 #include <vector>
 
 namespace dynvo {
@@ -76,6 +78,32 @@ private:
   Eigen::Matrix3d cross_sum_ =
       Eigen::Matrix3d::Zero(); ///< sum w_i (q_i - q0)(s_i - s0)^T
 };
+
+// Inline: the segmentation's hypotheses add about 20000 pairs per frame.
+inline void
+RigidFitAccumulator::add(const Eigen::Vector3d& source,
+                         const Eigen::Vector3d& target,
+                         double weight)
+{
+  if (!source.allFinite() || !target.allFinite() || !std::isfinite(weight) ||
+      weight < 0.0)
+    throw std::invalid_argument("[dynvo::RigidFitAccumulator::add] points must be "
+                                "finite and the weight finite and "
+                                ">= 0");
+  if (weight == 0.0)
+    return;
+  if (count_ == 0) {
+    source_origin_ = source;
+    target_origin_ = target;
+  }
+  const Eigen::Vector3d s = source - source_origin_;
+  const Eigen::Vector3d q = target - target_origin_;
+  ++count_;
+  weight_sum_ += weight;
+  source_sum_ += weight * s;
+  target_sum_ += weight * q;
+  cross_sum_.noalias() += (weight * q) * s.transpose();
+}
 
 /// One pair of an information-weighted fit: R source + t should equal target, with the
 /// error's information matrix (m^-2, symmetric positive semi-definite) and a weight >= 0.
