@@ -91,9 +91,10 @@ dbscan(int count, int min_points, const std::function<bool(int, int)>& neighbour
   const auto near = [&](int i, int j) {
     if (i == j)
       return true;
-    char& t = tested[static_cast<std::size_t>(std::min(i, j)) * count + std::max(i, j)];
+    const int a = std::min(i, j), b = std::max(i, j);
+    char& t = tested[static_cast<std::size_t>(a) * count + b];
     if (t == UNKNOWN)
-      t = neighbours(std::min(i, j), std::max(i, j)) ? NEAR : FAR;
+      t = neighbours(a, b) ? NEAR : FAR;
     return t == NEAR;
   };
   std::vector<char> visited(static_cast<std::size_t>(count), 0);
