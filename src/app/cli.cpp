@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <malloc.h>
 #include <sstream>
 
 namespace dynvo::app {
@@ -180,9 +181,33 @@ shortenLongWords(const std::string& text)
   return out;
 }
 
+namespace {
+
+/** Keeps the memory a frame frees for the next frame's buffers. By default glibc maps a
+ * large block on its own and unmaps it when freed, and returns the heap's free top to the
+ * system beyond a trim threshold (both adjusted as blocks are freed); a VGA frame frees a
+ * 9.8 MB cloud, its images and pyramids, and the next frame touched fresh pages again: 260-310
+ * page faults per frame on tum_fr1_xyz_200, a tenth of a one-thread run's wall time
+ * (src/app/NOTES.md, thirty-third session). Setting either threshold turns off glibc's
+ * adjustment of both, so both are set.
+ */
+void
+keepFreedMemory()
+{
+#ifdef __GLIBC__
+  constexpr int MMAP_THRESHOLD = 32 << 20; // glibc's largest on 64-bit
+  constexpr int TRIM_THRESHOLD = 64 << 20;
+  mallopt(M_MMAP_THRESHOLD, MMAP_THRESHOLD);
+  mallopt(M_TRIM_THRESHOLD, TRIM_THRESHOLD);
+#endif
+}
+
+} // namespace
+
 int
 runApp(const std::string& usage, const std::function<int()>& body)
 {
+  keepFreedMemory();
   try {
     return body();
   }

@@ -92,6 +92,8 @@ DYNVO_EXPORTS std::string shortenLongWords(const std::string& text);
 /** \brief Runs an app's body with the house exit-code policy.
  * UsageError: message and usage on stderr, exit 2. Other std::exception: message via
  * pcl::console::print_error, exit 1. Otherwise the body's return value (0 or 1).
+ * With glibc, first makes the process keep freed memory for reuse (mallopt): per-frame
+ * buffers are then not mapped afresh every frame.
  * \param[in] usage printed after a usage error, e.g. "dynvo_evaluate GT EST [options]"
  */
 DYNVO_EXPORTS int runApp(const std::string& usage, const std::function<int()>& body);
