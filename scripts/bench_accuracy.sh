@@ -8,7 +8,9 @@
 # -composite), the scenarios of PLAIN_SCENARIOS once more with -plain_objects (one flat colour per face:
 # rows RECORDING+SCENARIO+plain_objects), and adds the real recordings tum_fr1_xyz_200, tum_fr1_desk_fast and bonn_crowd_people
 # (people walking: no truth masks, so its moving_share is the share of pixels labelled moving, not an
-# error) as they are, each with its own intrinsics. On each sequence it runs dynvo_odometry with
+# error) as they are, each with its own intrinsics, and once more at 15 Hz (rows RECORDING@15Hz: every
+# other colour frame over the same span, so twice the motion between frames, as a slower camera or
+# dropped frames give). On each sequence it runs dynvo_odometry with
 # -labels_dir and -bench_reference cv_rgbd (OpenCV's RGB-D odometry over the whole image on the same
 # frames: column "RPE cv_rgbd") and again with -no_segmentation, scores trajectories and labels with
 # dynvo_evaluate, and prints one markdown table (also written to <work>/table.md). Sequences run one
@@ -24,12 +26,13 @@ Usage: scripts/bench_accuracy.sh [-frames N] [-only NAME[,NAME...]] [-work DIR] 
   -only LIST   comma-separated rows to run: a scenario name selects its synthetic sequence and
                its composites, RECORDING+NAME only that composite (RECORDING: $(commas $(composite_hosts))),
                RECORDING+NAME+plain_objects its plain-object composite (NAME: $(commas "${PLAIN_SCENARIOS[@]}")),
-               RECORDING the real recording as it is ($(commas "${REALS[@]}"))
+               RECORDING the real recording as it is ($(commas "${REALS[@]}")),
+               RECORDING@15Hz every other colour frame of it
                (default: everything)
   -work DIR    work folder (default \$DYNVO_BENCH_WORK or $BUILD/bench_accuracy); it must be
                empty or absent
   -force       reuse a work folder of an earlier run: deletes only its own synthetic/,
-               composite/, runs/ and table.md
+               composite/, halfrate/, runs/ and table.md
   -seed S      seed of every synthesised sequence and of dynvo_odometry (default 0)
 
 Environment: DYNVO_BUILD_DIR (default <repo>/build), DYNVO_SHARED_DATA_DIR (default
@@ -105,6 +108,7 @@ if [ -n "$ONLY" ]; then
     known=0
     [[ " ${SCENARIOS[*]} " != *" $n "* ]] || known=1
     [[ " ${REALS[*]} " != *" $n "* ]] || known=1
+    [[ " ${REALS[*]} " != *" ${n%@15Hz} "* ]] || [ "${n%@15Hz}" = "$n" ] || known=1
     for host in $(composite_hosts); do
       base="${n#"$host"+}"
       if [ "$base" != "$n" ] && [ "${HAS_OBJECT[$base]:-0}" = 1 ]; then known=1; fi
@@ -114,7 +118,7 @@ if [ -n "$ONLY" ]; then
     done
     [ "$known" = 1 ] ||
       die "-only: '$n' is neither a scenario of dynvo_synthesize -list, a real recording" \
-          "($(commas "${REALS[@]}")) nor RECORDING+SCENARIO with an object scenario and RECORDING" \
+          "($(commas "${REALS[@]}"), or RECORDING@15Hz) nor RECORDING+SCENARIO with an object scenario and RECORDING" \
           "one of $(commas $(composite_hosts)) (or RECORDING+SCENARIO+plain_objects, SCENARIO one of" \
           "$(commas "${PLAIN_SCENARIOS[@]}"))"
     WANT[$n]=1
@@ -130,10 +134,10 @@ if [ -d "$WORK" ] && [ -n "$(ls -A "$WORK")" ]; then
   [ "$FORCE" -eq 1 ] || die "work folder $WORK is not empty: pass -force to reuse it, or -work DIR"
   [ -e "$WORK/$MARK" ] ||
     die "work folder $WORK is not empty and was not made by bench_accuracy.sh (no $MARK): refusing to clean it"
-  say "Reusing $WORK: deleting its synthetic/, composite/, runs/ and table.md"
-  rm -rf -- "$WORK/synthetic" "$WORK/composite" "$WORK/runs" "$WORK/table.md"
+  say "Reusing $WORK: deleting its synthetic/, composite/, halfrate/, runs/ and table.md"
+  rm -rf -- "$WORK/synthetic" "$WORK/composite" "$WORK/halfrate" "$WORK/runs" "$WORK/table.md"
 fi
-mkdir -p "$WORK/synthetic" "$WORK/composite" "$WORK/runs"
+mkdir -p "$WORK/synthetic" "$WORK/composite" "$WORK/halfrate" "$WORK/runs"
 touch "$WORK/$MARK"
 WORK="$(cd "$WORK" && pwd)"
 
@@ -272,11 +276,14 @@ for real in "${REALS[@]}"; do
   fi
   want_real=0
   if selected "$real"; then want_real=1; fi
-  [ ${#want_composites[@]} -gt 0 ] || [ "$want_real" = 1 ] || continue
+  want_half=0
+  if selected "$real@15Hz" "$real"; then want_half=1; fi
+  [ ${#want_composites[@]} -gt 0 ] || [ "$want_real" = 1 ] || [ "$want_half" = 1 ] || continue
   if [ ! -f "$real_dir/rgb.txt" ] || [ ! -f "$real_dir/depth.txt" ] || [ ! -f "$real_dir/groundtruth.txt" ]; then
     skipped="the ${#want_composites[@]} composite row(s) into $real"
     [ ${#want_composites[@]} -gt 0 ] || skipped=""
     [ "$want_real" = 0 ] || skipped="${skipped:+$skipped and }the $real row"
+    [ "$want_half" = 0 ] || skipped="${skipped:+$skipped and }the $real@15Hz row"
     say "Skipping $skipped"
     echo "    no shared data at $real_dir (rgb.txt, depth.txt, groundtruth.txt);" \
          "set DYNVO_SHARED_DATA_DIR to the folder that holds $real/"
@@ -309,6 +316,15 @@ for real in "${REALS[@]}"; do
   if [ "$want_real" = 1 ]; then
     # No labels/: dynvo_evaluate -labels reports moving_share (near 0 on a static scene).
     run_row "$real" "$real_dir" "${STATIC_SCENE[$real]}" "${camera[@]}" -max_frames "$rframes"
+  fi
+  if [ "$want_half" = 1 ]; then
+    # The same span at half the rate: a view of the recording whose rgb.txt keeps the 1st, 3rd,
+    # ... of its first rframes colour frames (each still paired with its nearest depth image).
+    view="$WORK/halfrate/$real"
+    mkdir -p "$view"
+    for f in rgb depth depth.txt groundtruth.txt; do ln -sfn "$real_dir/$f" "$view/$f"; done
+    grep -v '^#' "$real_dir/rgb.txt" | head -n "$rframes" | awk 'NR % 2 == 1' >"$view/rgb.txt"
+    run_row "$real@15Hz" "$view" "${STATIC_SCENE[$real]}" "${camera[@]}"
   fi
 done
 
