@@ -108,7 +108,8 @@ if [ -n "$ONLY" ]; then
     known=0
     [[ " ${SCENARIOS[*]} " != *" $n "* ]] || known=1
     [[ " ${REALS[*]} " != *" $n "* ]] || known=1
-    [[ " ${REALS[*]} " != *" ${n%@15Hz} "* ]] || [ "${n%@15Hz}" = "$n" ] || known=1
+    recording="${n%@15Hz}"
+    if [ "$recording" != "$n" ] && [[ " ${REALS[*]} " == *" $recording "* ]]; then known=1; fi
     for host in $(composite_hosts); do
       base="${n#"$host"+}"
       if [ "$base" != "$n" ] && [ "${HAS_OBJECT[$base]:-0}" = 1 ]; then known=1; fi
